@@ -1,0 +1,55 @@
+// The surface BSDF: Lambertian diffuse coupled to GGX microfacet reflection (Kelemen & Szirmay-Kalos
+// energy coupling), built per hit from a Material and its texture lookups.
+//
+// Glossary (used across render/): wo = direction towards the viewer, wi = direction towards the
+// light, both unit and pointing away from the surface. eval() includes the |cos theta_i| factor.
+// pdf is per unit solid angle. Reflection only: wo and wi on opposite sides give 0.
+#pragma once
+#include <optional>
+#include <glm/glm.hpp>
+#include "render/core/frame.h"
+
+namespace vpl {
+
+struct BsdfParams {
+  glm::vec3 diffuse{0.0f};  // Lambertian albedo: baseColor x (1 - metallic)
+  glm::vec3 f0{0.04f};      // Fresnel reflectance at normal incidence (Schlick)
+  float alpha = 1.0f;       // GGX alpha = roughness^2, clamped to [kMinAlpha, 1]
+};
+
+struct BsdfSample {
+  glm::vec3 wi{0.0f};      // world space
+  glm::vec3 weight{0.0f};  // eval(wo, wi) / pdf
+  float pdf = 0.0f;        // solid angle, of the whole mixture (not only the chosen lobe)
+};
+
+class Bsdf {
+ public:
+  static constexpr float kMinAlpha = 1e-3f;  // keeps GGX finite as roughness -> 0
+
+  Bsdf() = default;
+  Bsdf(const BsdfParams& params, const Frame& shadingFrame);
+
+  // f(wo, wi) |cos theta_i|, world-space directions.
+  glm::vec3 eval(const glm::vec3& wo, const glm::vec3& wi) const;
+  // Density of sample() per unit solid angle.
+  float pdf(const glm::vec3& wo, const glm::vec3& wi) const;
+  // Picks a lobe with uLobe, then samples it (GGX: visible normals, Heitz 2018). Empty if no direction.
+  std::optional<BsdfSample> sample(const glm::vec3& wo, glm::vec2 u, float uLobe) const;
+
+  const BsdfParams& params() const { return params_; }
+  const Frame& frame() const { return frame_; }
+  // True when nearly all reflection is a narrow lobe, so a light path should not store a VPL here.
+  bool isNearSpecular() const;
+
+ private:
+  BsdfParams params_;
+  Frame frame_;
+  float diffuseProbability_ = 0.5f;  // lobe selection, precomputed from the params
+};
+
+// f0 of the glTF metallic-roughness model with KHR_materials_specular / KHR_materials_ior.
+glm::vec3 fresnelF0(const glm::vec3& baseColor, float metallic, float ior, float specularFactor,
+                    const glm::vec3& specularColor);
+
+}  // namespace vpl

@@ -1,0 +1,44 @@
+// Shared helpers of the unit tests: chi-square goodness of fit of direction samplers, paths to
+// scenes, and a skip when ../shared is absent.
+#pragma once
+#include <functional>
+#include <string>
+#include <glm/glm.hpp>
+#include <gtest/gtest.h>
+
+namespace vpl::test {
+
+struct ChiSquareResult {
+  double statistic = 0.0;
+  int degreesOfFreedom = 0;
+  double pValue = 1.0;
+  std::string report;  // a short table of the worst bins, for failure messages
+};
+
+// Bins n samples of a unit-direction sampler on an equal-area (cos theta, phi) grid of the whole
+// sphere and compares them with the integral of pdf over each bin (Simpson-like sub-grid
+// quadrature). Bins expecting fewer than 5 samples are pooled. A sampler that returns
+// std::nullopt-like failures should return a zero vector; those count as "no sample" and are
+// compared with 1 - integral(pdf).
+ChiSquareResult chiSquareSphere(const std::function<glm::vec3()>& sample,
+                                const std::function<double(const glm::vec3&)>& pdf, int sampleCount,
+                                int cosThetaBins = 32, int phiBins = 64, int subdivisions = 8);
+
+// Integral of f over the unit sphere by a fine (cos theta, phi) midpoint grid.
+double integrateSphere(const std::function<double(const glm::vec3&)>& f, int cosThetaSteps = 512,
+                       int phiSteps = 1024);
+
+// Upper tail of the chi-square distribution: P(X >= statistic) with dof degrees of freedom.
+double chiSquareTail(double statistic, int dof);
+
+std::string sourceDir();
+std::string sharedDir();
+// Path of a scene in ../shared/scenes, or "" (and GTEST_SKIP from the caller) when absent.
+std::string sharedScene(const std::string& relativePath);
+
+}  // namespace vpl::test
+
+// Skips the current test with a clear message when ../shared/scenes is not beside the repo.
+#define VPL_REQUIRE_SHARED_SCENE(var, rel)                                                   \
+  const std::string var = ::vpl::test::sharedScene(rel);                                     \
+  if (var.empty()) GTEST_SKIP() << "../shared/scenes/" << (rel) << " is absent: test skipped"
