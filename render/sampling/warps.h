@@ -1,0 +1,80 @@
+// Warps from the unit square to directions and points, with their densities. Local frames have
+// the axis on +z; u is uniform in [0,1)^2.
+#pragma once
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <glm/glm.hpp>
+
+namespace vpl {
+
+inline constexpr float kPi = std::numbers::pi_v<float>;
+inline constexpr float kInvPi = 1.0f / kPi;
+inline constexpr float kInv4Pi = 0.25f / kPi;
+
+inline glm::vec3 sampleUniformSphere(glm::vec2 u) {
+  const float z = 1.0f - 2.0f * u.x;
+  const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+  const float phi = 2.0f * kPi * u.y;
+  return {r * std::cos(phi), r * std::sin(phi), z};
+}
+inline float uniformSpherePdf() { return kInv4Pi; }
+
+inline glm::vec3 sampleUniformHemisphere(glm::vec2 u) {
+  const float z = u.x;
+  const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+  const float phi = 2.0f * kPi * u.y;
+  return {r * std::cos(phi), r * std::sin(phi), z};
+}
+inline float uniformHemispherePdf() { return 0.5f * kInvPi; }
+
+// Shirley & Chiu's concentric map: low distortion, so stratified u stay stratified.
+inline glm::vec2 sampleConcentricDisk(glm::vec2 u) {
+  const glm::vec2 o = 2.0f * u - 1.0f;
+  if (o.x == 0.0f && o.y == 0.0f) return {0.0f, 0.0f};
+  float r, theta;
+  if (std::abs(o.x) > std::abs(o.y)) {
+    r = o.x;
+    theta = 0.25f * kPi * (o.y / o.x);
+  } else {
+    r = o.y;
+    theta = 0.5f * kPi - 0.25f * kPi * (o.x / o.y);
+  }
+  return r * glm::vec2(std::cos(theta), std::sin(theta));
+}
+
+// Malley's method: project the disk up to the hemisphere.
+inline glm::vec3 sampleCosineHemisphere(glm::vec2 u) {
+  const glm::vec2 d = sampleConcentricDisk(u);
+  const float z = std::sqrt(std::max(0.0f, 1.0f - d.x * d.x - d.y * d.y));
+  return {d.x, d.y, z};
+}
+inline float cosineHemispherePdf(float cosTheta) { return cosTheta > 0.0f ? cosTheta * kInvPi : 0.0f; }
+
+// Uniform in the cone cos(theta) >= cosThetaMax. 1 - cos is carried explicitly so that cones down
+// to about 1e-3 degrees keep a correct pdf (1 - cosThetaMax is exact to float rounding of its input).
+inline glm::vec3 sampleUniformCone(glm::vec2 u, float cosThetaMax) {
+  const float oneMinusCosMax = 1.0f - cosThetaMax;
+  const float oneMinusCos = u.x * oneMinusCosMax;
+  const float cosTheta = 1.0f - oneMinusCos;
+  // sin^2 = (1 - cos)(1 + cos): no cancellation for small angles.
+  const float sinTheta = std::sqrt(std::max(0.0f, oneMinusCos * (2.0f - oneMinusCos)));
+  const float phi = 2.0f * kPi * u.y;
+  return {sinTheta * std::cos(phi), sinTheta * std::sin(phi), cosTheta};
+}
+inline float uniformConePdf(float cosThetaMax) { return 1.0f / (2.0f * kPi * std::max(1.0f - cosThetaMax, 1e-12f)); }
+
+// Uniform barycentrics (b1, b2) on a triangle; b0 = 1 - b1 - b2 (Heitz's low-distortion map, 2019).
+inline glm::vec2 sampleUniformTriangle(glm::vec2 u) {
+  float b0, b1;
+  if (u.x < u.y) {
+    b0 = u.x / 2.0f;
+    b1 = u.y - b0;
+  } else {
+    b1 = u.y / 2.0f;
+    b0 = u.x - b1;
+  }
+  return {b1, 1.0f - b0 - b1};
+}
+
+}  // namespace vpl
