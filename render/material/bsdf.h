@@ -45,7 +45,12 @@ class Bsdf {
  private:
   BsdfParams params_;
   Frame frame_;
-  float diffuseProbability_ = 0.5f;  // lobe selection, precomputed from the params
+  glm::vec3 diffuseScale_{0.0f};  // diffuse / (pi (1 - E_avg)): the coupled diffuse lobe's constant
+
+  glm::vec3 specularAlbedo(float mu) const;  // E(mu) per channel
+  float specularProbability(float cosO) const;
+  glm::vec3 evalLocal(const glm::vec3& wo, const glm::vec3& wi) const;
+  float pdfLocal(const glm::vec3& wo, const glm::vec3& wi) const;
 };
 
 // f0 of the glTF metallic-roughness model with KHR_materials_specular / KHR_materials_ior.

@@ -1,0 +1,114 @@
+#include "render/material/bsdf.h"
+
+#include <algorithm>
+#include <cmath>
+#include "render/core/color.h"
+#include "render/material/ggx.h"
+#include "render/material/specular_albedo.h"
+#include "render/sampling/warps.h"
+
+namespace vpl {
+
+glm::vec3 fresnelF0(const glm::vec3& baseColor, float metallic, float ior, float specularFactor,
+                    const glm::vec3& specularColor) {
+  const float r = (ior - 1.0f) / (ior + 1.0f);
+  const float f0Ior = std::isfinite(r) ? r * r : 0.04f;
+  const glm::vec3 dielectric = glm::min(glm::vec3(f0Ior) * specularColor, glm::vec3(1.0f)) * specularFactor;
+  const float m = glm::clamp(metallic, 0.0f, 1.0f);
+  return glm::clamp(dielectric * (1.0f - m) + baseColor * m, glm::vec3(0.0f), glm::vec3(1.0f));
+}
+
+Bsdf::Bsdf(const BsdfParams& params, const Frame& shadingFrame) : params_(params), frame_(shadingFrame) {
+  params_.alpha = std::clamp(params_.alpha, kMinAlpha, 1.0f);
+  params_.diffuse = glm::clamp(params_.diffuse, glm::vec3(0.0f), glm::vec3(1.0f));
+  params_.f0 = glm::clamp(params_.f0, glm::vec3(0.0f), glm::vec3(1.0f));
+  if (!isBlack(params_.diffuse)) {
+    const AlbedoTerms avg = averageSpecularAlbedo(params_.alpha);
+    const glm::vec3 eAvg = params_.f0 * avg.a + avg.b;
+    // Kelemen & Szirmay-Kalos (2001): the diffuse lobe gets what the specular lobe leaves, reciprocally.
+    diffuseScale_ = params_.diffuse * kInvPi / glm::max(glm::vec3(1.0f) - eAvg, glm::vec3(1e-4f));
+  }
+}
+
+glm::vec3 Bsdf::specularAlbedo(float mu) const {
+  const AlbedoTerms e = vpl::specularAlbedo(mu, params_.alpha);
+  return glm::clamp(params_.f0 * e.a + e.b, glm::vec3(0.0f), glm::vec3(1.0f));
+}
+
+// Probability of sampling the specular lobe: its share of the albedo seen from wo.
+float Bsdf::specularProbability(float cosO) const {
+  const glm::vec3 e = specularAlbedo(cosO);
+  const float spec = luminance(e);
+  const float diff = luminance(params_.diffuse * (glm::vec3(1.0f) - e));
+  if (spec + diff <= 0.0f) return 0.5f;
+  return spec / (spec + diff);
+}
+
+glm::vec3 Bsdf::evalLocal(const glm::vec3& wo, const glm::vec3& wi) const {
+  if (wo.z <= 0.0f || wi.z <= 0.0f) return glm::vec3(0.0f);
+  glm::vec3 f(0.0f);
+  if (!isBlack(diffuseScale_)) {
+    f += diffuseScale_ * (glm::vec3(1.0f) - specularAlbedo(wo.z)) * (glm::vec3(1.0f) - specularAlbedo(wi.z)) * wi.z;
+  }
+  if (!isBlack(params_.f0)) {
+    glm::vec3 h = wo + wi;
+    const float len = glm::length(h);
+    if (len > 1e-8f) {
+      h /= len;
+      // F D G2 / (4 cos_o cos_i), times cos_i.
+      f += ggx::schlick(params_.f0, glm::dot(wo, h)) *
+           (ggx::D(h, params_.alpha) * ggx::G2(wo, wi, params_.alpha) / (4.0f * wo.z));
+    }
+  }
+  return f;
+}
+
+float Bsdf::pdfLocal(const glm::vec3& wo, const glm::vec3& wi) const {
+  if (wo.z <= 0.0f || wi.z <= 0.0f) return 0.0f;
+  const float pSpec = specularProbability(wo.z);
+  float pdf = (1.0f - pSpec) * cosineHemispherePdf(wi.z);
+  if (pSpec > 0.0f) {
+    glm::vec3 h = wo + wi;
+    const float len = glm::length(h);
+    if (len > 1e-8f) pdf += pSpec * ggx::reflectionPdf(wo, h / len, params_.alpha);
+  }
+  return pdf;
+}
+
+glm::vec3 Bsdf::eval(const glm::vec3& wo, const glm::vec3& wi) const {
+  return evalLocal(frame_.toLocal(wo), frame_.toLocal(wi));
+}
+
+float Bsdf::pdf(const glm::vec3& wo, const glm::vec3& wi) const {
+  return pdfLocal(frame_.toLocal(wo), frame_.toLocal(wi));
+}
+
+std::optional<BsdfSample> Bsdf::sample(const glm::vec3& woWorld, glm::vec2 u, float uLobe) const {
+  const glm::vec3 wo = frame_.toLocal(woWorld);
+  if (wo.z <= 0.0f) return std::nullopt;
+  const float pSpec = specularProbability(wo.z);
+  glm::vec3 wi;
+  if (uLobe < pSpec) {
+    const glm::vec3 h = ggx::sampleVisibleNormal(wo, u, params_.alpha);
+    wi = 2.0f * glm::dot(wo, h) * h - wo;
+  } else {
+    wi = sampleCosineHemisphere(u);
+  }
+  if (wi.z <= 0.0f) return std::nullopt;
+  const float pdf = pdfLocal(wo, wi);
+  if (!(pdf > 0.0f) || !std::isfinite(pdf)) return std::nullopt;
+  BsdfSample s;
+  s.wi = glm::normalize(frame_.toWorld(wi));
+  s.pdf = pdf;
+  s.weight = evalLocal(wo, wi) / pdf;
+  if (!isFiniteNonNegative(s.weight)) return std::nullopt;
+  return s;
+}
+
+bool Bsdf::isNearSpecular() const {
+  // Below alpha 0.01 (roughness 0.1) the lobe is a few degrees wide: a VPL there would light the
+  // scene in sharp spikes, so light paths pass through it without storing one.
+  return params_.alpha < 0.01f && specularProbability(1.0f) > 0.9f;
+}
+
+}  // namespace vpl
