@@ -1,0 +1,39 @@
+// The accumulation buffer of a progressive render: per pixel, a sum of radiance samples, a sum of
+// squared luminance (for the relative-variance view) and a sample count.
+//
+// Threading contract: workers call addSample() only for pixels of tiles they own (no two threads
+// write one pixel at once); any thread may call resolve() at any time. Fields are relaxed atomics,
+// so a concurrent resolve() may see a pixel mid-update (a torn, still finite, value) but never races.
+#pragma once
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <glm/glm.hpp>
+#include "render/film/image.h"
+
+namespace vpl {
+
+class Film {
+ public:
+  Film(int width, int height);
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+
+  void addSample(int x, int y, const glm::vec3& radiance);
+  void clear();
+
+  Image resolve() const;           // per-pixel mean; pixels without samples are black
+  Image resolveVariance() const;   // per-pixel relative variance of the mean luminance, in all channels
+  uint64_t totalSamples() const;
+
+ private:
+  struct Pixel {
+    std::atomic<double> r{0}, g{0}, b{0}, lum2{0};
+    std::atomic<uint32_t> count{0};
+  };
+  int width_, height_;
+  std::unique_ptr<Pixel[]> pixels_;
+};
+
+}  // namespace vpl
