@@ -10,7 +10,7 @@ namespace vpl {
 
 namespace {
 
-constexpr int kMu = 32, kAlpha = 32, kSamples = 64;  // kSamples^2 stratified samples per entry
+constexpr int kMu = 32, kAlpha = 32, kSamples = 32;  // kSamples^2 stratified samples per entry
 
 struct Table {
   std::array<AlbedoTerms, kMu * kAlpha> e;

@@ -1,0 +1,100 @@
+#include "app/commands.h"
+
+#include <cstdio>
+#include <sstream>
+#include <unistd.h>
+#include <nlohmann/json.hpp>
+#include <tbb/global_control.h>
+#include "render/core/error.h"
+#include "render/film/image_io.h"
+#include "render/session/progress_bar.h"
+#include "render/session/render_job.h"
+#include "render/session/ray_benchmark.h"
+#include "app/render_options.h"
+
+namespace vpl::app {
+
+namespace {
+
+RenderOptions gRender, gBench;
+CLI::App* gRenderCommand = nullptr;
+CLI::App* gBenchCommand = nullptr;
+
+nlohmann::ordered_json summaryJson(const RenderJobSettings& s, const RenderJobResult& r) {
+  nlohmann::ordered_json j;
+  j["mode"] = modeName(s.mode);
+  j["width"] = s.width;
+  j["height"] = s.height;
+  j["spp"] = r.spp;
+  j["seconds"] = r.seconds;
+  j["timings"] = {{"load", r.timings.load}, {"bvh", r.timings.bvh}, {"vpl", r.timings.vpl},
+                  {"cluster", r.timings.cluster}, {"render", r.timings.render}};
+  j["first_image_s"] = r.firstImageSeconds;
+  j["rays"] = r.rays;
+  j["rays_per_s"] = r.timings.render > 0 ? double(r.rays) / r.timings.render : 0.0;
+  j["samples_per_s"] = r.timings.render > 0 ? double(r.samples) / r.timings.render : 0.0;
+  j["discarded"] = r.discarded;
+  j["bsdf_samples"] = r.bsdfSamples;
+  j["guide_samples"] = r.guideSamples;
+  j["triangles"] = r.triangles;
+  j["seed"] = s.seed;
+  j["threads"] = tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
+  j["scene"] = s.scenePath;
+  return j;
+}
+
+int runRender() {
+  RenderJobSettings settings = gRender.toSettings();
+  tbb::global_control threads(tbb::global_control::max_allowed_parallelism, gRender.threadCount());
+  // Check the outputs before spending minutes on a render that cannot be saved.
+  checkWritable(gRender.out);
+  if (!gRender.png.empty()) checkWritable(gRender.png);
+
+  ProgressBar bar("render", isatty(STDERR_FILENO) != 0);
+  const RenderJobResult result = runRenderJob(settings, [&](double f) { bar.update(f, ""); });
+  bar.finish();
+  for (const std::string& notice : result.notices) std::fprintf(stderr, "vplview: note: %s\n", notice.c_str());
+
+  writeExr(gRender.out, result.image);
+  if (!gRender.png.empty()) writePng(gRender.png, result.image, gRender.exposure);
+  std::printf("%s\n", summaryJson(settings, result).dump().c_str());
+  return 0;
+}
+
+int runBench() {
+  RenderJobSettings settings = gBench.toSettings();
+  tbb::global_control threads(tbb::global_control::max_allowed_parallelism, gBench.threadCount());
+  const RenderJobResult result = runRenderJob(settings);
+  const double pathRate = result.timings.render > 0 ? double(result.rays) / result.timings.render : 0.0;
+  const RayBenchmark raw = measureRawRayRate(settings.scenePath, gBench.rawSeconds, settings.seed);
+  nlohmann::ordered_json j = summaryJson(settings, result);
+  j["raw_rays_per_s"] = raw.raysPerSecond;
+  j["raw_rays"] = raw.rays;
+  j["path_vs_raw"] = raw.raysPerSecond > 0 ? pathRate / raw.raysPerSecond : 0.0;
+  std::fprintf(stderr, "path tracer %.3g rays/s, raw Embree %.3g rays/s (incoherent rtcIntersect1), ratio %.2f\n",
+               pathRate, raw.raysPerSecond, j["path_vs_raw"].get<double>());
+  std::printf("%s\n", j.dump().c_str());
+  return 0;
+}
+
+}  // namespace
+
+void registerCommands(CLI::App& app) {
+  gRenderCommand = app.add_subcommand("render", "render a scene headlessly to EXR (and PNG)");
+  gRender.addTo(*gRenderCommand, /*requireOut=*/true);
+
+  gBenchCommand = app.add_subcommand("bench", "path tracer rays/s against the raw Embree rate on the same scene");
+  gBench.addTo(*gBenchCommand, /*requireOut=*/false);
+  gBenchCommand->add_option("--raw-seconds", gBench.rawSeconds, "seconds of raw incoherent rtcIntersect1 rays")
+      ->check(CLI::PositiveNumber);
+}
+
+int runSelectedCommand(CLI::App& app) {
+  if (gRenderCommand->parsed()) return runRender();
+  if (gBenchCommand->parsed()) return runBench();
+  std::fprintf(stderr, "vplview: the viewer is not built yet; use 'vplview render SCENE --out X.exr' (see --help)\n");
+  (void)app;
+  return 2;
+}
+
+}  // namespace vpl::app

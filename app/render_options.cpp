@@ -1,0 +1,86 @@
+#include "app/render_options.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+#include <thread>
+#include "render/core/error.h"
+
+namespace vpl::app {
+
+namespace {
+
+glm::vec3 parseSky(const std::string& text) {
+  std::vector<float> values;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    char* end = nullptr;
+    const float v = std::strtof(item.c_str(), &end);
+    if (item.empty() || end != item.c_str() + item.size() || !std::isfinite(v) || v < 0.0f)
+      throw InputError("--sky: '" + text + "' is not R,G,B (three non-negative numbers) or 0");
+    values.push_back(v);
+  }
+  if (values.size() == 1) return glm::vec3(values[0]);
+  if (values.size() != 3) throw InputError("--sky: '" + text + "' is not R,G,B (three non-negative numbers) or 0");
+  return {values[0], values[1], values[2]};
+}
+
+}  // namespace
+
+void RenderOptions::addTo(CLI::App& command, bool requireOut) {
+  command.add_option("scene", scene, "glTF 2.0 scene (.gltf or .glb)")->required();
+  command.add_option("--mode", mode, "brdf | metropolis | mis | mixture | preview")
+      ->check(CLI::IsMember({"brdf", "metropolis", "mis", "mixture", "preview"}));
+  auto* sppOpt = command.add_option("--spp", spp, "samples per pixel")->check(CLI::PositiveNumber);
+  auto* timeOpt = command.add_option("--time", time, "seconds after loading (preprocessing included)")
+                      ->check(CLI::PositiveNumber);
+  sppOpt->excludes(timeOpt);
+  command.add_option("--width", width, "image width in pixels")->check(CLI::Range(1, 16384));
+  command.add_option("--height", height, "image height in pixels")->check(CLI::Range(1, 16384));
+  command.add_option("--seed", seed, "random seed (same seed, same image)");
+  command.add_option("--threads", threads, "worker threads (0: all cores)")->check(CLI::Range(0, 1024));
+  command.add_option("--max-depth", maxDepth, "maximum path length in segments (1: direct light only)")
+      ->check(CLI::Range(1, 1024));
+  command.add_option("--sky", sky, "uniform sky radiance R,G,B; 0 turns it off (default: on only without lights)");
+  auto* outOpt = command.add_option("--out", out, "output OpenEXR image (linear RGB float)");
+  if (requireOut) outOpt->required();
+  command.add_option("--png", png, "also write an sRGB PNG");
+  command.add_option("--exposure", exposure, "PNG exposure in stops");
+}
+
+RenderJobSettings RenderOptions::toSettings() const {
+  RenderJobSettings s;
+  s.scenePath = scene;
+  s.mode = *parseMode(mode);
+  s.width = width;
+  s.height = height;
+  s.seed = seed;
+  s.spp = spp > 0 ? spp : 16;
+  s.timeBudget = time;
+  s.tracer.maxDepth = maxDepth;
+  if (!sky.empty()) {
+    s.sky.explicitSky = true;
+    s.sky.radiance = parseSky(sky);
+  }
+  return s;
+}
+
+int RenderOptions::threadCount() const {
+  return threads > 0 ? threads : int(std::max(1u, std::thread::hardware_concurrency()));
+}
+
+void checkWritable(const std::string& path) {
+  const std::filesystem::path p(path);
+  const std::filesystem::path dir = p.has_parent_path() ? p.parent_path() : std::filesystem::path(".");
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec)) throw InputError(path + ": folder " + dir.string() + " does not exist");
+  const bool existed = std::filesystem::exists(p, ec);
+  std::FILE* f = std::fopen(path.c_str(), "ab");
+  if (!f) throw InputError(path + ": cannot write here");
+  std::fclose(f);
+  if (!existed) std::filesystem::remove(p, ec);
+}
+
+}  // namespace vpl::app

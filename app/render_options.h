@@ -1,0 +1,32 @@
+// The options shared by the headless commands (render, bench, capture, ...), bound to CLI11.
+#pragma once
+#include <string>
+#include <CLI/CLI.hpp>
+#include "render/session/render_job.h"
+
+namespace vpl::app {
+
+struct RenderOptions {
+  std::string scene;
+  std::string mode = "brdf";
+  int spp = 0;
+  double time = 0.0;
+  int width = 640, height = 480;
+  uint64_t seed = 1;
+  int threads = 0;  // 0 = all cores
+  int maxDepth = 32;
+  std::string out, png;
+  std::string sky;  // "R,G,B", "0", or empty (automatic)
+  float exposure = 0.0f;
+  double rawSeconds = 3.0;  // bench only
+
+  void addTo(CLI::App& command, bool requireOut);
+  // Checked conversion; throws InputError for values CLI11 cannot check alone.
+  RenderJobSettings toSettings() const;
+  int threadCount() const;
+};
+
+// Throws InputError when a file cannot be created at path (missing folder, no permission).
+void checkWritable(const std::string& path);
+
+}  // namespace vpl::app

@@ -1,0 +1,76 @@
+// Unidirectional path tracer with next-event estimation. The continuation direction at each vertex
+// comes from the BSDF (`brdf`) or, in the guided modes, from the VPL guide (see render/guide/).
+//
+// Parameters (PathTracerSettings):
+//   maxDepth      int   32    path segments from the camera; 1 = direct light only
+//   rrStartDepth  int   3     first depth at which Russian roulette may end a path
+#pragma once
+#include <cstdint>
+#include <string>
+#include <glm/glm.hpp>
+#include "render/sampling/rng.h"
+#include "render/scene/render_scene.h"
+
+namespace vpl {
+
+struct PathTracerSettings {
+  int maxDepth = 32;
+  int rrStartDepth = 3;
+
+  // Empty when valid, else a readable reason.
+  std::string validate() const;
+};
+
+// Counters of one worker; summed by the caller.
+struct PathStats {
+  uint64_t rays = 0;          // intersection + shadow rays
+  uint64_t bsdfSamples = 0;   // continuation directions drawn from the BSDF
+  uint64_t guideSamples = 0;  // continuation directions drawn from the guide
+};
+
+// How a vertex picks its continuation direction. The BSDF strategy is the reference; guided
+// strategies implement the same interface so the tracer's MIS and weights stay one code path.
+struct DirectionSample {
+  glm::vec3 wi{0.0f};
+  float pdf = 0.0f;  // solid angle density of the strategy as a whole (the density MIS needs)
+};
+
+class ContinuationSampler {
+ public:
+  virtual ~ContinuationSampler() = default;
+  // Picks a direction at this vertex; returns false when the path should end.
+  virtual bool sample(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, Rng& rng,
+                      DirectionSample& out, PathStats& stats) = 0;
+  // Density with which sample() would return wi at this vertex.
+  virtual float pdf(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, const glm::vec3& wi) = 0;
+};
+
+// Plain BSDF importance sampling (the `brdf` mode).
+class BsdfContinuation final : public ContinuationSampler {
+ public:
+  bool sample(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, Rng& rng, DirectionSample& out,
+              PathStats& stats) override;
+  float pdf(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, const glm::vec3& wi) override;
+};
+
+class PathTracer {
+ public:
+  PathTracer(const RenderScene& scene, const PathTracerSettings& settings) : scene_(scene), settings_(settings) {}
+
+  // Radiance arriving along the camera ray. May be non-finite only through a bug; callers check.
+  glm::vec3 radiance(const Ray& cameraRay, Rng& rng, ContinuationSampler& continuation, PathStats& stats) const;
+
+  const PathTracerSettings& settings() const { return settings_; }
+
+ private:
+  const RenderScene& scene_;
+  PathTracerSettings settings_;
+};
+
+// Power heuristic with exponent 2 (Veach 1997, §9.2.4).
+inline float powerHeuristic(float pdfA, float pdfB) {
+  const float a = pdfA * pdfA, b = pdfB * pdfB;
+  return a + b > 0.0f ? a / (a + b) : 0.0f;
+}
+
+}  // namespace vpl

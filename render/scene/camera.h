@@ -1,0 +1,35 @@
+// Pinhole camera: primary rays through jittered pixel positions.
+#pragma once
+#include <glm/glm.hpp>
+#include "render/scene/accel.h"
+#include "render/scene/scene_data.h"
+
+namespace vpl {
+
+class Camera {
+ public:
+  Camera() = default;
+  Camera(const CameraData& data, int width, int height);
+
+  // Ray through image position (x, y) in pixels, (0, 0) the top-left corner of the image.
+  Ray generateRay(glm::vec2 pixel) const;
+
+  const CameraData& data() const { return data_; }
+  int width() const { return width_; }
+  int height() const { return height_; }
+
+ private:
+  CameraData data_;
+  int width_ = 1, height_ = 1;
+  glm::vec3 forward_{0, 0, -1}, right_{1, 0, 0}, up_{0, 1, 0};
+  float tanHalfY_ = 0.4f, tanHalfX_ = 0.4f;
+};
+
+// A camera that sees the whole scene: looking at the bounds' centre along -Z from outside the
+// bounding sphere (the usual viewer default when a file has no camera).
+CameraData frameBounds(const glm::vec3& boundsMin, const glm::vec3& boundsMax, float yfov = 0.7f);
+
+// The file's camera if it has one, else frameBounds.
+CameraData defaultCamera(const SceneData& scene);
+
+}  // namespace vpl

@@ -1,0 +1,74 @@
+// Every light of a scene in one power-weighted distribution: emissive triangles, KHR punctual
+// lights and the uniform sky. Next-event estimation samples it; emitter hits ask it for the pdf.
+#pragma once
+#include <cstdint>
+#include <optional>
+#include <vector>
+#include <glm/glm.hpp>
+#include "render/sampling/distribution_1d.h"
+#include "render/scene/scene_data.h"
+#include "render/scene/surface.h"
+
+namespace vpl {
+
+struct LightSample {
+  glm::vec3 wi{0.0f};         // unit, from the reference point towards the light
+  float distance = INFINITY;  // to the light point (INFINITY for sky and directional)
+  glm::vec3 radiance{0.0f};   // Li arriving at the reference point (irradiance for delta lights)
+  float pdf = 0.0f;           // solid angle density incl. the light choice; for delta lights the choice pmf
+  bool delta = false;         // punctual light: no MIS with BSDF sampling
+};
+
+// Where a light path starts (instant radiosity): a point and direction drawn from the emission.
+struct EmissionSample {
+  glm::vec3 position{0.0f};
+  glm::vec3 normal{0.0f};     // emitter surface normal, 0 for point-like and sky
+  glm::vec3 direction{0.0f};  // unit, direction of travel
+  glm::vec3 weight{0.0f};     // Le cos / (pdf_pos pdf_dir): the flux the path carries, summed over N paths / N
+};
+
+class EmitterSet {
+ public:
+  EmitterSet() = default;
+  // sceneCentre/sceneRadius bound the scene (the sky and the sun are sampled from outside it).
+  EmitterSet(const SceneData& scene, const glm::vec3& sky, const glm::vec3& sceneCentre, float sceneRadius);
+
+  bool empty() const { return distribution_.empty(); }
+  size_t triangleCount() const { return triangles_.size(); }
+
+  // Next-event estimation from point p; u = three uniforms.
+  std::optional<LightSample> sample(const glm::vec3& p, float uLight, glm::vec2 u) const;
+  // Density (solid angle, at p) with which sample() picks the emitting triangle point x of a hit.
+  float pdfTriangle(const glm::vec3& p, const SurfaceHit& hit) const;
+  // Density with which sample() picks direction wi towards the sky.
+  float pdfSky(const glm::vec3& wi) const;
+
+  // Starting vertex of a light path, for VPL tracing.
+  std::optional<EmissionSample> sampleEmission(float uLight, glm::vec2 uPos, glm::vec2 uDir) const;
+
+  // Emitted radiance of a surface hit towards wo (0 unless the material emits on that side).
+  glm::vec3 emitted(const SurfaceHit& hit, const glm::vec3& wo) const;
+  glm::vec3 sky() const { return sky_; }
+  bool hasSky() const { return skyIndex_ >= 0; }
+
+ private:
+  struct TriangleLight {
+    uint32_t mesh, triangle;
+    float area;
+    bool twoSided;
+  };
+  const SceneData* scene_ = nullptr;
+  std::vector<TriangleLight> triangles_;
+  std::vector<PunctualLight> punctual_;
+  // For each mesh, the emitter index of each triangle (empty for non-emissive meshes).
+  std::vector<std::vector<int32_t>> triangleIndex_;
+  Distribution1D distribution_;  // over [triangles..., punctual..., sky]
+  int skyIndex_ = -1;
+  glm::vec3 sky_{0.0f};
+  glm::vec3 centre_{0.0f};
+  float radius_ = 1.0f;
+
+  glm::vec3 triangleRadiance(const TriangleLight& light, glm::vec2 barycentric, bool frontSide) const;
+};
+
+}  // namespace vpl

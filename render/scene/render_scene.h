@@ -1,0 +1,52 @@
+// The immutable snapshot the renderer works on: scene data, its Embree BVH, its emitters, and the
+// conversion of a ray hit into a shading point. Built once per loaded scene; shared by all threads.
+#pragma once
+#include <memory>
+#include <glm/glm.hpp>
+#include "render/material/bsdf.h"
+#include "render/scene/accel.h"
+#include "render/scene/emitters.h"
+#include "render/scene/scene_data.h"
+#include "render/scene/surface.h"
+
+namespace vpl {
+
+struct SkySettings {
+  // Unset: a uniform white sky only when the scene has no light at all.
+  bool explicitSky = false;
+  glm::vec3 radiance{1.0f};
+};
+
+class RenderScene {
+ public:
+  RenderScene(SceneData data, const SkySettings& sky = {});
+
+  const SceneData& data() const { return data_; }
+  const Accel& accel() const { return *accel_; }
+  const EmitterSet& emitters() const { return emitters_; }
+  glm::vec3 centre() const { return centre_; }
+  float radius() const { return radius_; }
+  // True when the sky was switched on because the scene has no light (the CLI prints a notice).
+  bool usesDefaultSky() const { return defaultSky_; }
+
+  // Shading point of a hit; wo is the unit direction back along the ray.
+  SurfaceHit surface(const Ray& ray, const RayHit& hit) const;
+  // BSDF parameters at a hit: texture lookups only for textured materials.
+  BsdfParams bsdfParams(const SurfaceHit& hit) const;
+  Bsdf bsdf(const SurfaceHit& hit) const { return Bsdf(bsdfParams(hit), Frame::fromNormal(hit.shadingNormal)); }
+
+ private:
+  SceneData data_;
+  std::unique_ptr<Accel> accel_;
+  EmitterSet emitters_;
+  glm::vec3 centre_{0.0f};
+  float radius_ = 1.0f;
+  bool defaultSky_ = false;
+};
+
+// A ray leaving a surface towards wi, offset to avoid re-hitting it.
+Ray spawnRay(const SurfaceHit& from, const glm::vec3& wi);
+// A shadow ray from a surface towards a point at distance (INFINITY: towards a direction).
+Ray spawnShadowRay(const SurfaceHit& from, const glm::vec3& wi, float distance);
+
+}  // namespace vpl

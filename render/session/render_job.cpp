@@ -1,0 +1,104 @@
+#include "render/session/render_job.h"
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <mutex>
+#include <thread>
+#include "render/core/error.h"
+#include "render/film/film.h"
+#include "render/scene/camera.h"
+#include "render/scene/gltf_loader.h"
+#include "render/session/tile_renderer.h"
+
+namespace vpl {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+// Raises a stop flag at a deadline, or earlier when destroyed.
+class DeadlineWatch {
+ public:
+  DeadlineWatch(Clock::time_point deadline, std::atomic<bool>& flag)
+      : thread_([this, deadline, &flag] {
+          std::unique_lock lock(mutex_);
+          if (!cv_.wait_until(lock, deadline, [this] { return done_; })) flag.store(true);
+        }) {}
+  ~DeadlineWatch() {
+    { std::lock_guard lock(mutex_); done_ = true; }
+    cv_.notify_all();
+    thread_.join();
+  }
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  bool done_ = false;
+  std::thread thread_;
+};
+
+}  // namespace
+
+std::string RenderJobSettings::validate() const {
+  if (scenePath.empty()) return "no scene given";
+  if (width < 1 || height < 1 || width > 16384 || height > 16384) return "image size must be between 1 and 16384 pixels";
+  if (timeBudget <= 0.0 && spp < 1) return "spp must be at least 1";
+  if (timeBudget > 0.0 && !(timeBudget < 1e7)) return "time budget is too large";
+  if (std::string e = tracer.validate(); !e.empty()) return e;
+  return {};
+}
+
+RenderJobResult runRenderJob(const RenderJobSettings& settings, const std::function<void(double)>& progress) {
+  if (std::string e = settings.validate(); !e.empty()) throw InputError(e);
+  if (settings.mode != SamplingMode::Brdf)
+    throw InputError(std::string("mode '") + modeName(settings.mode) + "' is not available in this build yet");
+
+  RenderJobResult result;
+  const auto start = Clock::now();
+  SceneData data = loadGltf(settings.scenePath);
+  result.timings.load = secondsSince(start);
+  result.notices = data.notices;
+  result.triangles = data.triangleCount();
+
+  // Everything from here counts against --time: equal-time comparisons include preprocessing.
+  const auto loaded = Clock::now();
+  const auto deadline = loaded + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(settings.timeBudget));
+  const RenderScene scene(std::move(data), settings.sky);
+  result.timings.bvh = secondsSince(loaded);
+  if (scene.usesDefaultSky()) result.notices.push_back("the scene has no light: lit by a uniform white sky (--sky to change, --sky 0 for none)");
+
+  const Camera camera(defaultCamera(scene.data()), settings.width, settings.height);
+  const PathTracer tracer(scene, settings.tracer);
+  const TileRenderer renderer(scene, camera, tracer, settings.seed, nullptr);
+  Film film(settings.width, settings.height);
+
+  const auto renderStart = Clock::now();
+  std::atomic<bool> stop{false};
+  std::optional<DeadlineWatch> watch;
+  const bool timed = settings.timeBudget > 0.0;
+  if (timed) watch.emplace(deadline, stop);
+  for (uint64_t pass = 0;; ++pass) {
+    if (!timed && int(pass) >= settings.spp) break;
+    if (timed && pass > 0 && stop.load()) break;
+    // The first pass always completes: a budget never leaves an empty image.
+    const PassStats stats = renderer.renderPass(film, pass, pass == 0 ? nullptr : &stop);
+    result.rays += stats.rays;
+    result.samples += stats.samples;
+    result.discarded += stats.discarded;
+    result.bsdfSamples += stats.bsdfSamples;
+    result.guideSamples += stats.guideSamples;
+    if (timed && pass > 0 && stop.load()) break;  // cut short: not a complete pass
+    ++result.spp;
+    if (pass == 0) result.firstImageSeconds = secondsSince(loaded);
+    if (progress) progress(timed ? std::min(1.0, secondsSince(loaded) / settings.timeBudget) : double(pass + 1) / settings.spp);
+  }
+  watch.reset();
+  result.timings.render = secondsSince(renderStart);
+  result.seconds = secondsSince(loaded);
+  result.image = film.resolve();
+  return result;
+}
+
+}  // namespace vpl

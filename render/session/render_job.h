@@ -1,0 +1,47 @@
+// A complete headless render: load, build, (guide,) render to a spp or time budget. The CLI's
+// `render`, `bench` and `converge` commands and the end-to-end tests all go through here.
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+#include "render/film/image.h"
+#include "render/integrator/path_tracer.h"
+#include "render/integrator/sampling_mode.h"
+#include "render/scene/render_scene.h"
+
+namespace vpl {
+
+struct RenderJobSettings {
+  std::string scenePath;
+  SamplingMode mode = SamplingMode::Brdf;
+  int width = 640, height = 480;
+  uint64_t seed = 1;
+  int spp = 16;               // used when timeBudget <= 0
+  double timeBudget = 0.0;    // seconds after load (BVH, VPLs, clustering and rendering all count)
+  PathTracerSettings tracer;
+  SkySettings sky;
+
+  std::string validate() const;  // empty when valid
+};
+
+struct PhaseTimings {
+  double load = 0, bvh = 0, vpl = 0, cluster = 0, render = 0;
+};
+
+struct RenderJobResult {
+  Image image;
+  int spp = 0;                 // complete passes
+  double seconds = 0.0;        // wall time after load
+  double firstImageSeconds = 0.0;
+  PhaseTimings timings;
+  uint64_t rays = 0, samples = 0, discarded = 0, bsdfSamples = 0, guideSamples = 0;
+  size_t triangles = 0;
+  std::vector<std::string> notices;
+};
+
+// progress(fraction in [0,1]) is called after every pass.
+RenderJobResult runRenderJob(const RenderJobSettings& settings,
+                             const std::function<void(double)>& progress = nullptr);
+
+}  // namespace vpl

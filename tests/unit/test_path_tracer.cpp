@@ -1,0 +1,116 @@
+// The reference path tracer (`brdf`) against analytic answers and against itself.
+#include <cmath>
+#include <tbb/global_control.h>
+#include "render/film/film.h"
+#include "render/integrator/path_tracer.h"
+#include "render/scene/camera.h"
+#include "render/scene/gltf_loader.h"
+#include "render/session/tile_renderer.h"
+#include "tests/unit/scene_builders.h"
+#include "tests/unit/support.h"
+
+namespace vpl {
+namespace {
+
+struct Rendered {
+  Image image;
+  PassStats stats;
+};
+
+Rendered renderScene(const RenderScene& scene, int width, int height, int spp, uint64_t seed, int maxDepth = 64) {
+  const Camera camera(defaultCamera(scene.data()), width, height);
+  PathTracerSettings settings;
+  settings.maxDepth = maxDepth;
+  const PathTracer tracer(scene, settings);
+  const TileRenderer renderer(scene, camera, tracer, seed, nullptr);
+  Film film(width, height);
+  Rendered r;
+  for (int pass = 0; pass < spp; ++pass) r.stats += renderer.renderPass(film, uint64_t(pass));
+  r.image = film.resolve();
+  return r;
+}
+
+// Per-channel image mean and the standard error of that mean, treating pixels as independent.
+struct MeanAndError {
+  double mean, error;
+};
+MeanAndError channelMean(const Image& image, int channel) {
+  double sum = 0, sum2 = 0;
+  const size_t n = image.pixels.size();
+  for (const glm::vec3& p : image.pixels) {
+    sum += p[channel];
+    sum2 += double(p[channel]) * p[channel];
+  }
+  const double mean = sum / n;
+  return {mean, std::sqrt(std::max(0.0, sum2 / n - mean * mean) / n)};
+}
+
+class WhiteFurnace : public ::testing::TestWithParam<float> {};
+
+TEST_P(WhiteFurnace, ConvergesToAnalyticRadiance) {
+  const float rho = GetParam(), le = 0.5f;
+  const RenderScene scene(test::furnaceScene(rho, le));
+  const Rendered r = renderScene(scene, 32, 32, 64, 11, 1024);
+  const double expected = le / (1.0 - rho);
+  for (int c = 0; c < 3; ++c) {
+    const MeanAndError m = channelMean(r.image, c);
+    EXPECT_NEAR(m.mean, expected, 4.0 * m.error + 1e-3 * expected) << "rho " << rho << " channel " << c;
+  }
+  EXPECT_EQ(r.stats.discarded, 0u);
+}
+
+INSTANTIATE_TEST_SUITE_P(Albedos, WhiteFurnace, ::testing::Values(0.0f, 0.5f, 0.8f));
+
+TEST(WhiteFurnace, GlossyMetalNeverGainsEnergy) {
+  // A perfect-white rough metal reflects at most what it receives: radiance <= le / (1 - 1) is
+  // unbounded, so bound it by the path length instead: L <= le * (depth + 1).
+  SceneData s = test::furnaceScene(1.0f, 0.5f);
+  s.materials[0].metallic = 1.0f;
+  s.materials[0].roughness = 0.4f;
+  s.materials[0].specularFactor = 1.0f;
+  const int depth = 8;
+  const RenderScene scene(std::move(s));
+  const Rendered r = renderScene(scene, 16, 16, 32, 3, depth);
+  const MeanAndError m = channelMean(r.image, 1);
+  EXPECT_LE(m.mean, 0.5 * (depth + 1) + 4.0 * m.error);
+  EXPECT_GT(m.mean, 0.5);  // it does reflect something
+}
+
+TEST(PathTracer, SameSeedSameImageForAnyThreadCount) {
+  const RenderScene scene(test::furnaceScene(0.7f, 1.0f));
+  Image one, two;
+  {
+    tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
+    one = renderScene(scene, 24, 20, 4, 5).image;
+  }
+  {
+    tbb::global_control c(tbb::global_control::max_allowed_parallelism, 2);
+    two = renderScene(scene, 24, 20, 4, 5).image;
+  }
+  ASSERT_EQ(one.pixels.size(), two.pixels.size());
+  for (size_t i = 0; i < one.pixels.size(); ++i) ASSERT_EQ(one.pixels[i], two.pixels[i]) << "pixel " << i;
+}
+
+TEST(PathTracer, CornellBoxSeedsAgreeWithinNoise) {
+  const std::string path = test::sourceDir() + "/scenes/cornell_box.gltf";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " not generated yet";
+  const RenderScene scene(loadGltf(path));
+  const Image a = renderScene(scene, 48, 48, 32, 1, 32).image;
+  const Image b = renderScene(scene, 48, 48, 32, 2, 32).image;
+  for (int c = 0; c < 3; ++c) {
+    // The per-pixel difference of independent renders has mean 0; test its image mean.
+    double sum = 0, sum2 = 0;
+    for (size_t i = 0; i < a.pixels.size(); ++i) {
+      const double d = double(a.pixels[i][c]) - b.pixels[i][c];
+      sum += d;
+      sum2 += d * d;
+    }
+    const double n = double(a.pixels.size()), mean = sum / n;
+    const double error = std::sqrt((sum2 / n - mean * mean) / n);
+    EXPECT_LT(std::abs(mean), 4.0 * error) << "channel " << c;
+    EXPECT_GT(channelMean(a, c).mean, 0.01);  // the box is lit
+  }
+}
+
+}  // namespace
+}  // namespace vpl
