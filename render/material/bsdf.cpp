@@ -22,9 +22,10 @@ Bsdf::Bsdf(const BsdfParams& params, const Frame& shadingFrame) : params_(params
   params_.alpha = std::clamp(params_.alpha, kMinAlpha, 1.0f);
   params_.diffuse = glm::clamp(params_.diffuse, glm::vec3(0.0f), glm::vec3(1.0f));
   params_.f0 = glm::clamp(params_.f0, glm::vec3(0.0f), glm::vec3(1.0f));
+  params_.f90 = std::clamp(params_.f90, 0.0f, 1.0f);
   if (!isBlack(params_.diffuse)) {
     const AlbedoTerms avg = averageSpecularAlbedo(params_.alpha);
-    const glm::vec3 eAvg = params_.f0 * avg.a + avg.b;
+    const glm::vec3 eAvg = params_.f0 * avg.a + params_.f90 * avg.b;
     // Kelemen & Szirmay-Kalos (2001): the diffuse lobe gets what the specular lobe leaves, reciprocally.
     diffuseScale_ = params_.diffuse * kInvPi / glm::max(glm::vec3(1.0f) - eAvg, glm::vec3(1e-4f));
   }
@@ -32,7 +33,7 @@ Bsdf::Bsdf(const BsdfParams& params, const Frame& shadingFrame) : params_(params
 
 glm::vec3 Bsdf::specularAlbedo(float mu) const {
   const AlbedoTerms e = vpl::specularAlbedo(mu, params_.alpha);
-  return glm::clamp(params_.f0 * e.a + e.b, glm::vec3(0.0f), glm::vec3(1.0f));
+  return glm::clamp(params_.f0 * e.a + params_.f90 * e.b, glm::vec3(0.0f), glm::vec3(1.0f));
 }
 
 // Probability of sampling the specular lobe: its share of the albedo seen from wo.
@@ -50,13 +51,13 @@ glm::vec3 Bsdf::evalLocal(const glm::vec3& wo, const glm::vec3& wi) const {
   if (!isBlack(diffuseScale_)) {
     f += diffuseScale_ * (glm::vec3(1.0f) - specularAlbedo(wo.z)) * (glm::vec3(1.0f) - specularAlbedo(wi.z)) * wi.z;
   }
-  if (!isBlack(params_.f0)) {
+  if (hasSpecular()) {
     glm::vec3 h = wo + wi;
     const float len = glm::length(h);
     if (len > 1e-8f) {
       h /= len;
       // F D G2 / (4 cos_o cos_i), times cos_i.
-      f += ggx::schlick(params_.f0, glm::dot(wo, h)) *
+      f += ggx::schlick(params_.f0, params_.f90, glm::dot(wo, h)) *
            (ggx::D(h, params_.alpha) * ggx::G2(wo, wi, params_.alpha) / (4.0f * wo.z));
     }
   }

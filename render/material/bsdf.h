@@ -14,6 +14,7 @@ namespace vpl {
 struct BsdfParams {
   glm::vec3 diffuse{0.0f};  // Lambertian albedo: baseColor x (1 - metallic)
   glm::vec3 f0{0.04f};      // Fresnel reflectance at normal incidence (Schlick)
+  float f90 = 1.0f;         // Fresnel reflectance at grazing incidence (KHR_materials_specular's specularFactor)
   float alpha = 1.0f;       // GGX alpha = roughness^2, clamped to [kMinAlpha, 1]
 };
 
@@ -48,6 +49,7 @@ class Bsdf {
   glm::vec3 diffuseScale_{0.0f};  // diffuse / (pi (1 - E_avg)): the coupled diffuse lobe's constant
 
   glm::vec3 specularAlbedo(float mu) const;  // E(mu) per channel
+  bool hasSpecular() const { return params_.f90 > 0.0f || params_.f0.x > 0.0f || params_.f0.y > 0.0f || params_.f0.z > 0.0f; }
   float specularProbability(float cosO) const;
   glm::vec3 evalLocal(const glm::vec3& wo, const glm::vec3& wi) const;
   float pdfLocal(const glm::vec3& wo, const glm::vec3& wi) const;
@@ -56,5 +58,10 @@ class Bsdf {
 // f0 of the glTF metallic-roughness model with KHR_materials_specular / KHR_materials_ior.
 glm::vec3 fresnelF0(const glm::vec3& baseColor, float metallic, float ior, float specularFactor,
                     const glm::vec3& specularColor);
+// f90: specularFactor for dielectrics, 1 for metals (KHR_materials_specular), mixed by metallic.
+inline float fresnelF90(float metallic, float specularFactor) {
+  const float m = glm::clamp(metallic, 0.0f, 1.0f);
+  return glm::clamp(specularFactor, 0.0f, 1.0f) * (1.0f - m) + m;
+}
 
 }  // namespace vpl

@@ -49,10 +49,11 @@ inline float reflectionPdf(const glm::vec3& wo, const glm::vec3& h, float alpha)
   return G1(wo, alpha) * D(h, alpha) / (4.0f * wo.z);
 }
 
-inline glm::vec3 schlick(const glm::vec3& f0, float cosTheta) {
+// Schlick's Fresnel with an explicit grazing value f90 (1 for the classic form).
+inline glm::vec3 schlick(const glm::vec3& f0, float f90, float cosTheta) {
   const float m = std::clamp(1.0f - cosTheta, 0.0f, 1.0f);
   const float m5 = (m * m) * (m * m) * m;
-  return f0 + (glm::vec3(1.0f) - f0) * m5;
+  return f0 + (glm::vec3(f90) - f0) * m5;
 }
 
 }  // namespace vpl::ggx

@@ -17,10 +17,8 @@ Distribution1D::Distribution1D(std::span<const float> weights) {
   }
   total_ = sum;
   if (!(sum > 0.0)) return;
-  for (size_t i = 0; i < n; ++i) {
-    pmf_[i] = float((cdf_[i + 1] - cdf_[i]) / sum);
-    cdf_[i + 1] /= sum;
-  }
+  for (size_t i = 0; i < n; ++i) pmf_[i] = float((cdf_[i + 1] - cdf_[i]) / sum);
+  for (size_t i = 1; i <= n; ++i) cdf_[i] /= sum;
   cdf_[n] = 1.0;
 }
 

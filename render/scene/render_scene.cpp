@@ -77,6 +77,7 @@ BsdfParams RenderScene::bsdfParams(const SurfaceHit& hit) const {
   BsdfParams p;
   p.diffuse = baseColor * (1.0f - metallic);
   p.f0 = fresnelF0(baseColor, metallic, m.ior, m.specularFactor, m.specularColor);
+  p.f90 = fresnelF90(metallic, m.specularFactor);
   p.alpha = std::max(roughness * roughness, Bsdf::kMinAlpha);
   return p;
 }
