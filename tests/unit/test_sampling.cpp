@@ -1,0 +1,203 @@
+// Warps and the discrete distribution: every sampler against its own pdf (chi-square).
+#include <cmath>
+#include <numbers>
+#include <vector>
+#include "render/core/frame.h"
+#include "render/sampling/distribution_1d.h"
+#include "render/sampling/rng.h"
+#include "render/sampling/warps.h"
+#include "tests/unit/support.h"
+
+namespace vpl {
+namespace {
+
+constexpr double kSignificance = 1e-3;  // per test; the suite has a handful of them
+
+TEST(Warps, UniformSphereMatchesPdf) {
+  Rng rng(1);
+  const auto r = test::chiSquareSphere([&] { return sampleUniformSphere(rng.uniform2()); },
+                                       [](const glm::vec3&) { return double(uniformSpherePdf()); }, 200000);
+  EXPECT_GT(r.pValue, kSignificance) << r.report;
+}
+
+TEST(Warps, UniformHemisphereMatchesPdf) {
+  Rng rng(2);
+  const auto r = test::chiSquareSphere([&] { return sampleUniformHemisphere(rng.uniform2()); },
+                                       [](const glm::vec3& w) { return w.z > 0 ? double(uniformHemispherePdf()) : 0.0; }, 200000);
+  EXPECT_GT(r.pValue, kSignificance) << r.report;
+}
+
+TEST(Warps, CosineHemisphereMatchesPdf) {
+  Rng rng(3);
+  const auto r = test::chiSquareSphere([&] { return sampleCosineHemisphere(rng.uniform2()); },
+                                       [](const glm::vec3& w) { return double(cosineHemispherePdf(w.z)); }, 200000);
+  EXPECT_GT(r.pValue, kSignificance) << r.report;
+}
+
+TEST(Warps, ConesMatchPdfAndIntegrateToOne) {
+  for (float degrees : {60.0f, 20.0f}) {
+    const float cosMax = std::cos(degrees * kPi / 180.0f);
+    const glm::vec3 axis = glm::normalize(glm::vec3(0.3f, -0.5f, 0.8f));
+    const Frame frame = Frame::fromNormal(axis);
+    Rng rng(4);
+    auto pdf = [&](const glm::vec3& w) { return glm::dot(w, axis) >= cosMax ? double(uniformConePdf(cosMax)) : 0.0; };
+    const auto r = test::chiSquareSphere([&] { return frame.toWorld(sampleUniformCone(rng.uniform2(), cosMax)); }, pdf,
+                                         200000, 64, 128, 48);
+    EXPECT_GT(r.pValue, kSignificance) << degrees << " deg: " << r.report;
+    EXPECT_NEAR(test::integrateSphere(pdf, 1024, 2048), 1.0, 0.02) << degrees;
+  }
+}
+
+TEST(Warps, NarrowConeInvertsToUniformSquare) {
+  // Narrow cones are too small for sphere bins: map the samples back to the unit square instead,
+  // where a uniform cone is a uniform square (1 - cos theta linear in u.x, phi linear in u.y).
+  for (float degrees : {9.0f, 1.0f}) {
+    const float cosMax = std::cos(degrees * kPi / 180.0f);
+    const int bins = 16, n = 100000;
+    std::vector<double> counts(size_t(bins * bins), 0.0);
+    Rng rng(10);
+    for (int i = 0; i < n; ++i) {
+      const glm::vec3 w = sampleUniformCone(rng.uniform2(), cosMax);
+      ASSERT_GE(w.z, cosMax - 1e-6f);
+      const double sin2 = double(w.x) * w.x + double(w.y) * w.y;
+      const double oneMinusCos = sin2 / (1.0 + double(w.z));  // 1 - cos without cancellation
+      double phi = std::atan2(double(w.y), double(w.x));
+      if (phi < 0) phi += 2.0 * std::numbers::pi;
+      const int a = std::clamp(int(oneMinusCos / (1.0 - double(cosMax)) * bins), 0, bins - 1);
+      const int b = std::clamp(int(phi / (2.0 * std::numbers::pi) * bins), 0, bins - 1);
+      counts[size_t(a * bins + b)] += 1;
+    }
+    double chi2 = 0;
+    const double expected = double(n) / (bins * bins);
+    for (double c : counts) chi2 += (c - expected) * (c - expected) / expected;
+    EXPECT_GT(test::chiSquareTail(chi2, bins * bins - 1), kSignificance) << degrees << " deg, chi2 " << chi2;
+  }
+}
+
+TEST(Warps, TinyConePdfStaysFiniteAndSamplesStayInside) {
+  const float cosMax = std::cos(1e-3f * kPi / 180.0f);
+  EXPECT_TRUE(std::isfinite(uniformConePdf(cosMax)));
+  EXPECT_TRUE(std::isfinite(uniformConePdf(1.0f)));
+  Rng rng(5);
+  for (int i = 0; i < 1000; ++i) EXPECT_GE(sampleUniformCone(rng.uniform2(), cosMax).z, cosMax - 1e-6f);
+}
+
+// 2D binning on the unit square for warps to the disk and the triangle.
+template <typename Fn, typename Inside>
+double chiSquare2d(Fn sample, Inside inside, double area, int bins, int n) {
+  std::vector<double> observed(size_t(bins * bins), 0.0), expected(size_t(bins * bins), 0.0);
+  for (int i = 0; i < n; ++i) {
+    const glm::vec2 p = sample();
+    const int x = std::clamp(int(p.x * bins), 0, bins - 1), y = std::clamp(int(p.y * bins), 0, bins - 1);
+    observed[size_t(y * bins + x)] += 1;
+  }
+  constexpr int kSub = 16;
+  for (int y = 0; y < bins; ++y)
+    for (int x = 0; x < bins; ++x) {
+      int in = 0;
+      for (int a = 0; a < kSub; ++a)
+        for (int b = 0; b < kSub; ++b) in += inside(glm::vec2((x + (a + 0.5) / kSub) / bins, (y + (b + 0.5) / kSub) / bins));
+      expected[size_t(y * bins + x)] = double(in) / (kSub * kSub) / (bins * bins) / area * n;
+    }
+  double chi2 = 0;
+  int dof = -1;
+  for (size_t k = 0; k < observed.size(); ++k) {
+    if (expected[k] < 5) {
+      EXPECT_LE(observed[k], expected[k] + 30) << "bin " << k;  // edge bins: only a loose check
+      continue;
+    }
+    chi2 += (observed[k] - expected[k]) * (observed[k] - expected[k]) / expected[k];
+    ++dof;
+  }
+  return test::chiSquareTail(chi2, dof);
+}
+
+TEST(Warps, ConcentricDiskIsUniform) {
+  Rng rng(6);
+  const double p = chiSquare2d([&] { return 0.5f * (sampleConcentricDisk(rng.uniform2()) + 1.0f); },
+                               [](glm::vec2 q) { return glm::length(2.0f * q - 1.0f) <= 1.0f; }, kPi / 4.0, 24, 200000);
+  EXPECT_GT(p, kSignificance);
+}
+
+TEST(Warps, TriangleBarycentricsAreUniform) {
+  Rng rng(7);
+  const double p = chiSquare2d([&] { return sampleUniformTriangle(rng.uniform2()); },
+                               [](glm::vec2 q) { return q.x + q.y <= 1.0f; }, 0.5, 24, 200000);
+  EXPECT_GT(p, kSignificance);
+}
+
+TEST(Distribution1D, SamplesFollowWeightsAndSkipZeros) {
+  const std::vector<float> w = {0.0f, 1.0f, 3.0f, 0.0f, 0.5f, -2.0f, NAN, 2.5f, INFINITY, 0.0f};
+  const Distribution1D d(w);
+  ASSERT_FALSE(d.empty());
+  EXPECT_DOUBLE_EQ(d.total(), 7.0);
+  std::vector<double> counts(w.size(), 0.0);
+  Rng rng(8);
+  const int n = 200000;
+  double chi2 = 0;
+  for (int i = 0; i < n; ++i) {
+    float pmf = 0, remapped = 0;
+    const size_t k = d.sample(rng.uniform(), &pmf, &remapped);
+    ASSERT_LT(k, w.size());
+    ASSERT_GT(pmf, 0.0f) << "picked zero-weight index " << k;
+    ASSERT_FLOAT_EQ(pmf, d.pmf(k));
+    ASSERT_GE(remapped, 0.0f);
+    ASSERT_LT(remapped, 1.0f);
+    counts[k] += 1;
+  }
+  int dof = -1;
+  for (size_t k = 0; k < w.size(); ++k) {
+    const double expected = d.pmf(k) * n;
+    if (expected == 0) {
+      EXPECT_EQ(counts[k], 0) << k;
+      continue;
+    }
+    chi2 += (counts[k] - expected) * (counts[k] - expected) / expected;
+    ++dof;
+  }
+  EXPECT_GT(test::chiSquareTail(chi2, dof), kSignificance) << "chi2 " << chi2;
+  EXPECT_NEAR(d.pmf(2), 3.0f / 7.0f, 1e-6f);
+}
+
+TEST(Distribution1D, RemappedUniformIsUniform) {
+  const std::vector<float> w = {1.0f, 5.0f, 0.0f, 2.0f};
+  const Distribution1D d(w);
+  Rng rng(9);
+  std::vector<double> bins(20, 0.0);
+  const int n = 100000;
+  for (int i = 0; i < n; ++i) {
+    float r = 0;
+    d.sample(rng.uniform(), nullptr, &r);
+    bins[std::min(size_t(r * 20), size_t(19))] += 1;
+  }
+  double chi2 = 0;
+  for (double b : bins) chi2 += (b - n / 20.0) * (b - n / 20.0) / (n / 20.0);
+  EXPECT_GT(test::chiSquareTail(chi2, 19), kSignificance);
+}
+
+TEST(Distribution1D, EmptyAndAllZero) {
+  EXPECT_TRUE(Distribution1D().empty());
+  const std::vector<float> zeros(5, 0.0f);
+  EXPECT_TRUE(Distribution1D(zeros).empty());
+  const std::vector<float> one = {4.0f};
+  const Distribution1D d(one);
+  float pmf = 0;
+  EXPECT_EQ(d.sample(0.999999f, &pmf), 0u);
+  EXPECT_FLOAT_EQ(pmf, 1.0f);
+}
+
+TEST(Rng, SameStreamSameNumbersAndUniformRange) {
+  Rng a = Rng::forSample(3, 1234, 7), b = Rng::forSample(3, 1234, 7), c = Rng::forSample(3, 1234, 8);
+  bool differs = false;
+  for (int i = 0; i < 100; ++i) {
+    const float x = a.uniform();
+    ASSERT_EQ(x, b.uniform());
+    ASSERT_GE(x, 0.0f);
+    ASSERT_LT(x, 1.0f);
+    differs |= x != c.uniform();
+  }
+  EXPECT_TRUE(differs);
+}
+
+}  // namespace
+}  // namespace vpl
