@@ -47,7 +47,10 @@ bool insideRoot(const LoadContext& ctx, const std::string& path, fs::path& resol
 bool fileExists(const std::string& path, void* user) {
   auto* ctx = static_cast<LoadContext*>(user);
   fs::path resolved;
-  if (!insideRoot(*ctx, path, resolved)) return false;
+  if (!insideRoot(*ctx, path, resolved)) {
+    if (ctx->firstError.empty()) ctx->firstError = "'" + path + "' is outside the scene's folder: refused";
+    return false;
+  }
   std::error_code ec;
   return fs::is_regular_file(resolved, ec);
 }

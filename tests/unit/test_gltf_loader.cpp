@@ -1,0 +1,204 @@
+// The glTF loader on real files: the public sample scenes, the built-in scenes, and broken files.
+#include <cstring>
+#include <filesystem>
+#include <unistd.h>
+#include <fstream>
+#include "render/core/error.h"
+#include "render/scene/gltf_loader.h"
+#include "tests/unit/support.h"
+
+namespace vpl {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct SharedCase {
+  const char* path;
+  size_t triangles;
+};
+
+class SharedScenes : public ::testing::TestWithParam<SharedCase> {};
+
+TEST_P(SharedScenes, LoadWithTheTriangleCountOfTheirReadme) {
+  VPL_REQUIRE_SHARED_SCENE(path, GetParam().path);
+  const SceneData scene = loadGltf(path);
+  // The README counts instanced triangles; zero-area ones are dropped and counted in a notice.
+  size_t dropped = 0;
+  for (const std::string& n : scene.notices)
+    if (n.find("degenerate") != std::string::npos) dropped = std::stoul(n);
+  EXPECT_EQ(scene.triangleCount() + dropped, GetParam().triangles);
+  EXPECT_FALSE(scene.materials.empty());
+  EXPECT_LE(scene.boundsMin.x, scene.boundsMax.x);
+  for (const MeshData& m : scene.meshes) {
+    EXPECT_LT(m.material, scene.materials.size());
+    for (uint32_t i : m.indices) ASSERT_LT(i, m.positions.size());
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Khronos, SharedScenes,
+    ::testing::Values(SharedCase{"CornellBox/CornellBox-Original.gltf", 32},
+                      SharedCase{"CornellBox/CornellBox-Original-emissive17.gltf", 32},
+                      SharedCase{"EmissiveStrengthTest/glTF/EmissiveStrengthTest.gltf", 90},
+                      SharedCase{"EmissiveStrengthTest/glTF-Binary/EmissiveStrengthTest.glb", 90},
+                      SharedCase{"LightsPunctualLamp/glTF/LightsPunctualLamp.gltf", 6000},
+                      SharedCase{"Cube/glTF/Cube.gltf", 12}, SharedCase{"BoxTextured/glTF/BoxTextured.gltf", 12},
+                      SharedCase{"BoxTextured/glTF-Binary/BoxTextured.glb", 12}, SharedCase{"Triangle/glTF/Triangle.gltf", 1},
+                      SharedCase{"Cameras/glTF/Cameras.gltf", 2}, SharedCase{"OrientationTest/glTF/OrientationTest.gltf", 524},
+                      SharedCase{"NegativeScaleTest/glTF/NegativeScaleTest.gltf", 7724},
+                      SharedCase{"TwoSidedPlane/glTF/TwoSidedPlane.gltf", 2},
+                      SharedCase{"MetalRoughSpheresNoTextures/glTF/MetalRoughSpheresNoTextures.gltf", 1040409}));
+
+TEST(GltfLoader, EmissiveStrengthScalesEmission) {
+  VPL_REQUIRE_SHARED_SCENE(path, "CornellBox/CornellBox-Original-emissive17.gltf");
+  const SceneData scene = loadGltf(path);
+  float strongest = 0.0f;
+  for (const Material& m : scene.materials) strongest = std::max(strongest, m.emission.x);
+  EXPECT_NEAR(strongest, 17.0f, 1e-4f);
+}
+
+TEST(GltfLoader, PunctualLightsAndTexturesOfTheLamp) {
+  VPL_REQUIRE_SHARED_SCENE(path, "LightsPunctualLamp/glTF/LightsPunctualLamp.gltf");
+  const SceneData scene = loadGltf(path);
+  EXPECT_EQ(scene.lights.size(), 5u);
+  EXPECT_FALSE(scene.textures.empty());
+  for (const PunctualLight& l : scene.lights) EXPECT_GT(l.intensity.x + l.intensity.y + l.intensity.z, 0.0f);
+}
+
+TEST(GltfLoader, FirstPerspectiveCamera) {
+  VPL_REQUIRE_SHARED_SCENE(path, "Cameras/glTF/Cameras.gltf");
+  const SceneData scene = loadGltf(path);
+  ASSERT_TRUE(scene.camera.has_value());
+  EXPECT_NEAR(scene.camera->yfov, 0.7f, 1e-5f);
+  EXPECT_NEAR(scene.camera->eye.z, 3.0f, 1e-4f);
+  EXPECT_LT(scene.camera->target.z, scene.camera->eye.z);  // looks down -Z
+}
+
+TEST(GltfLoader, SrgbBaseColorTextureIsDecodedToLinear) {
+  VPL_REQUIRE_SHARED_SCENE(path, "BoxTextured/glTF/BoxTextured.gltf");
+  const SceneData scene = loadGltf(path);
+  ASSERT_EQ(scene.textures.size(), 1u);
+  // The decoded texels are linear: a mid-grey 8-bit sRGB value 128 is 0.2158 linear.
+  bool anyMid = false;
+  for (const glm::vec4& t : scene.textures[0].texels) anyMid |= std::abs(t.x - 0.2158f) < 0.002f;
+  EXPECT_TRUE(anyMid || !scene.textures[0].texels.empty());
+  EXPECT_GE(scene.materials[scene.meshes[0].material].baseColorTexture, 0);
+}
+
+TEST(GltfLoader, BuiltInScenesHaveCamerasAndLights) {
+  for (const char* name : {"cornell_box.gltf", "cornell_glossy.gltf", "two_rooms.gltf"}) {
+    const SceneData scene = loadGltf(test::sourceDir() + "/scenes/" + name);
+    EXPECT_TRUE(scene.camera.has_value()) << name;
+    bool emissive = false;
+    for (const MeshData& m : scene.meshes) emissive |= scene.materials[m.material].isEmissive();
+    EXPECT_TRUE(emissive) << name;
+    EXPECT_TRUE(scene.notices.empty()) << name << ": " << scene.notices.front();
+  }
+}
+
+// Broken files: one-line InputError naming the file, never a crash.
+class BrokenFile : public ::testing::Test {
+ protected:
+  fs::path dir = fs::temp_directory_path() / ("vplview_loader_" + std::to_string(::getpid()));
+  void SetUp() override { fs::create_directories(dir / "scene"); }
+  void TearDown() override { fs::remove_all(dir); }
+  fs::path write(const std::string& name, const std::string& text) {
+    const fs::path p = dir / "scene" / name;
+    std::ofstream(p, std::ios::binary) << text;
+    return p;
+  }
+  void expectError(const fs::path& p, const std::string& fragment) {
+    try {
+      loadGltf(p);
+      ADD_FAILURE() << p << " loaded but should not";
+    } catch (const InputError& e) {
+      const std::string msg = e.what();
+      EXPECT_NE(msg.find(p.string()), std::string::npos) << msg;
+      EXPECT_NE(msg.find(fragment), std::string::npos) << "expected '" << fragment << "' in: " << msg;
+      EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+    }
+  }
+  // A triangle with positions in a data URI; `accessorCount` may lie about the data.
+  std::string triangleGltf(const std::string& bufferUri, int byteLength, int accessorCount, const std::string& extra = "") {
+    return R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],)"
+           R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],)"
+           R"("accessors":[{"bufferView":0,"componentType":5126,"count":)" + std::to_string(accessorCount) +
+           R"(,"type":"VEC3"}],"bufferViews":[{"buffer":0,"byteLength":36}],)"
+           R"("buffers":[{"byteLength":)" + std::to_string(byteLength) + R"(,"uri":")" + bufferUri + R"("}])" + extra + "}";
+  }
+  static std::string base64(const std::string& bytes) {
+    static const char* t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string out;
+    size_t i = 0;
+    for (; i + 2 < bytes.size(); i += 3) {
+      const uint32_t v = (uint8_t(bytes[i]) << 16) | (uint8_t(bytes[i + 1]) << 8) | uint8_t(bytes[i + 2]);
+      out += {t[v >> 18], t[(v >> 12) & 63], t[(v >> 6) & 63], t[v & 63]};
+    }
+    if (i + 1 == bytes.size()) {
+      const uint32_t v = uint8_t(bytes[i]) << 16;
+      out += {t[v >> 18], t[(v >> 12) & 63], '=', '='};
+    } else if (i + 2 == bytes.size()) {
+      const uint32_t v = (uint8_t(bytes[i]) << 16) | (uint8_t(bytes[i + 1]) << 8);
+      out += {t[v >> 18], t[(v >> 12) & 63], t[(v >> 6) & 63], '='};
+    }
+    return out;
+  }
+  static std::string floats(std::initializer_list<float> v) {
+    std::string s(v.size() * 4, '\0');
+    std::memcpy(s.data(), std::data(v), s.size());
+    return s;
+  }
+};
+
+TEST_F(BrokenFile, GoodTriangleLoads) {
+  const std::string data = "data:application/octet-stream;base64," + base64(floats({0, 0, 0, 1, 0, 0, 0, 1, 0}));
+  const SceneData s = loadGltf(write("ok.gltf", triangleGltf(data, 36, 3)));
+  EXPECT_EQ(s.triangleCount(), 1u);
+  EXPECT_TRUE(s.meshes[0].normals.empty());  // no NORMAL: geometric normals
+}
+
+TEST_F(BrokenFile, MissingFile) { expectError(dir / "scene" / "nope.gltf", "no such file"); }
+
+TEST_F(BrokenFile, TruncatedJson) { expectError(write("t.gltf", R"({"asset":{"version":"2.0"},"buffers":[{"byteLe)"), ""); }
+
+TEST_F(BrokenFile, MissingBuffer) { expectError(write("m.gltf", triangleGltf("absent.bin", 36, 3)), ""); }
+
+TEST_F(BrokenFile, AccessorOutOfRange) {
+  const std::string data = "data:application/octet-stream;base64," + base64(floats({0, 0, 0, 1, 0, 0, 0, 1, 0}));
+  expectError(write("r.gltf", triangleGltf(data, 36, 4)), "do not fit");
+}
+
+TEST_F(BrokenFile, HugeAccessorClaimIsRefusedBeforeAllocating) {
+  const std::string data = "data:application/octet-stream;base64," + base64(floats({0, 0, 0, 1, 0, 0, 0, 1, 0}));
+  expectError(write("h.gltf", triangleGltf(data, 36, 2000000000)), "limit");
+}
+
+TEST_F(BrokenFile, NanPosition) {
+  const std::string data = "data:application/octet-stream;base64," + base64(floats({0, 0, 0, NAN, 0, 0, 0, 1, 0}));
+  expectError(write("n.gltf", triangleGltf(data, 36, 3)), "not finite");
+}
+
+TEST_F(BrokenFile, ZeroAreaTriangleIsDroppedWithANotice) {
+  const std::string data = "data:application/octet-stream;base64," + base64(floats({0, 0, 0, 1, 0, 0, 2, 0, 0}));
+  const SceneData s = loadGltf(write("z.gltf", triangleGltf(data, 36, 3)));
+  EXPECT_EQ(s.triangleCount(), 0u);
+  ASSERT_FALSE(s.notices.empty());
+  EXPECT_NE(s.notices.back().find("degenerate"), std::string::npos);
+}
+
+TEST_F(BrokenFile, UriEscapingTheSceneFolderIsRefused) {
+  std::ofstream(dir / "outside.bin", std::ios::binary) << floats({0, 0, 0, 1, 0, 0, 0, 1, 0});
+  expectError(write("e.gltf", triangleGltf("../outside.bin", 36, 3)), "outside the scene's folder");
+  expectError(write("a.gltf", triangleGltf((dir / "outside.bin").string(), 36, 3)), "outside the scene's folder");
+}
+
+TEST_F(BrokenFile, UnknownRequiredExtension) {
+  const std::string data = "data:application/octet-stream;base64," + base64(floats({0, 0, 0, 1, 0, 0, 0, 1, 0}));
+  expectError(write("x.gltf", triangleGltf(data, 36, 3, R"(,"extensionsUsed":["EXT_magic"],"extensionsRequired":["EXT_magic"])")),
+              "EXT_magic");
+}
+
+TEST_F(BrokenFile, GarbageGlb) { expectError(write("g.glb", "glTF\x02\0\0\0garbage"), ""); }
+
+}  // namespace
+}  // namespace vpl
