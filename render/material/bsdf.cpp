@@ -23,7 +23,9 @@ Bsdf::Bsdf(const BsdfParams& params, const Frame& shadingFrame) : params_(params
   params_.diffuse = glm::clamp(params_.diffuse, glm::vec3(0.0f), glm::vec3(1.0f));
   params_.f0 = glm::clamp(params_.f0, glm::vec3(0.0f), glm::vec3(1.0f));
   params_.f90 = std::clamp(params_.f90, 0.0f, 1.0f);
-  if (!isBlack(params_.diffuse)) {
+  if (!isBlack(params_.diffuse) && !hasSpecular()) {
+    diffuseScale_ = params_.diffuse * kInvPi;  // pure Lambertian: no coupling needed
+  } else if (!isBlack(params_.diffuse)) {
     const AlbedoTerms avg = averageSpecularAlbedo(params_.alpha);
     const glm::vec3 eAvg = params_.f0 * avg.a + params_.f90 * avg.b;
     // Kelemen & Szirmay-Kalos (2001): the diffuse lobe gets what the specular lobe leaves, reciprocally.
@@ -32,12 +34,17 @@ Bsdf::Bsdf(const BsdfParams& params, const Frame& shadingFrame) : params_(params
 }
 
 glm::vec3 Bsdf::specularAlbedo(float mu) const {
+  if (!hasSpecular()) return glm::vec3(0.0f);
+  if (mu == cachedMu_) return cachedAlbedo_;
   const AlbedoTerms e = vpl::specularAlbedo(mu, params_.alpha);
-  return glm::clamp(params_.f0 * e.a + params_.f90 * e.b, glm::vec3(0.0f), glm::vec3(1.0f));
+  cachedMu_ = mu;
+  cachedAlbedo_ = glm::clamp(params_.f0 * e.a + params_.f90 * e.b, glm::vec3(0.0f), glm::vec3(1.0f));
+  return cachedAlbedo_;
 }
 
 // Probability of sampling the specular lobe: its share of the albedo seen from wo.
 float Bsdf::specularProbability(float cosO) const {
+  if (!hasSpecular()) return 0.0f;
   const glm::vec3 e = specularAlbedo(cosO);
   const float spec = luminance(e);
   const float diff = luminance(params_.diffuse * (glm::vec3(1.0f) - e));
@@ -49,7 +56,15 @@ glm::vec3 Bsdf::evalLocal(const glm::vec3& wo, const glm::vec3& wi) const {
   if (wo.z <= 0.0f || wi.z <= 0.0f) return glm::vec3(0.0f);
   glm::vec3 f(0.0f);
   if (!isBlack(diffuseScale_)) {
-    f += diffuseScale_ * (glm::vec3(1.0f) - specularAlbedo(wo.z)) * (glm::vec3(1.0f) - specularAlbedo(wi.z)) * wi.z;
+    if (hasSpecular()) {
+      // E(mu_o) first, so the cache keeps it for the next call at this vertex.
+      const glm::vec3 eo = specularAlbedo(wo.z);
+      const AlbedoTerms ti = vpl::specularAlbedo(wi.z, params_.alpha);
+      const glm::vec3 ei = glm::clamp(params_.f0 * ti.a + params_.f90 * ti.b, glm::vec3(0.0f), glm::vec3(1.0f));
+      f += diffuseScale_ * (glm::vec3(1.0f) - eo) * (glm::vec3(1.0f) - ei) * wi.z;
+    } else {
+      f += diffuseScale_ * wi.z;
+    }
   }
   if (hasSpecular()) {
     glm::vec3 h = wo + wi;

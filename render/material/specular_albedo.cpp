@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <mutex>
 #include "render/material/ggx.h"
 
 namespace vpl {
@@ -44,10 +43,9 @@ AlbedoTerms integrate(float mu, float alpha) {
   return {float(a / n), float(b / n)};
 }
 
-const Table& table() {
-  static Table t;
-  static std::once_flag once;
-  std::call_once(once, [] {
+Table buildTable() {
+  Table t;
+  {
     for (int j = 0; j < kAlpha; ++j) {
       double avgA = 0.0, avgB = 0.0;
       for (int i = 0; i < kMu; ++i) {
@@ -62,7 +60,13 @@ const Table& table() {
       }
       t.average[j] = {float(2.0 * avgA), float(2.0 * avgB)};
     }
-  });
+  }
+  return t;
+}
+
+// Built on first use (a few milliseconds); a function-local static is thread-safe and cheap to check.
+const Table& table() {
+  static const Table t = buildTable();
   return t;
 }
 
