@@ -1,0 +1,87 @@
+// The headless render job: sky rules, budgets, and errors, through the same entry point as the CLI.
+#include <cmath>
+#include "render/core/error.h"
+#include "render/film/image_metrics.h"
+#include "render/session/render_job.h"
+#include "tests/unit/support.h"
+
+namespace vpl {
+namespace {
+
+RenderJobSettings small(const std::string& scene) {
+  RenderJobSettings s;
+  s.scenePath = scene;
+  s.width = 32;
+  s.height = 24;
+  s.spp = 2;
+  return s;
+}
+
+bool hasNotice(const RenderJobResult& r, const std::string& text) {
+  for (const std::string& n : r.notices)
+    if (n.find(text) != std::string::npos) return true;
+  return false;
+}
+
+TEST(RenderJob, SceneWithoutLightsGetsTheDefaultSkyWithANotice) {
+  VPL_REQUIRE_SHARED_SCENE(path, "Triangle/glTF/Triangle.gltf");
+  const RenderJobResult r = runRenderJob(small(path));
+  EXPECT_TRUE(hasNotice(r, "uniform white sky"));
+  EXPECT_GT(meanRgb(r.image).y, 0.1);  // the background is the sky
+}
+
+TEST(RenderJob, SkyOffMeansBlackWithoutCrashing) {
+  VPL_REQUIRE_SHARED_SCENE(path, "Triangle/glTF/Triangle.gltf");
+  RenderJobSettings s = small(path);
+  s.sky.explicitSky = true;
+  s.sky.radiance = glm::vec3(0.0f);
+  const RenderJobResult r = runRenderJob(s);
+  EXPECT_EQ(meanRgb(r.image), glm::dvec3(0.0));
+  EXPECT_EQ(r.discarded, 0u);
+  EXPECT_FALSE(hasNotice(r, "uniform white sky"));
+}
+
+TEST(RenderJob, ExplicitSkyColourLightsALitScene) {
+  RenderJobSettings s = small(test::sourceDir() + "/scenes/cornell_box.gltf");
+  const double base = meanRgb(runRenderJob(s).image).y;
+  s.sky.explicitSky = true;
+  s.sky.radiance = glm::vec3(0.0f, 5.0f, 0.0f);  // the box is open at the front: the sky adds green
+  const glm::dvec3 lit = meanRgb(runRenderJob(s).image);
+  EXPECT_GT(lit.y, base);
+}
+
+TEST(RenderJob, TimeBudgetIsHonouredAndGivesAtLeastOnePass) {
+  RenderJobSettings s = small(test::sourceDir() + "/scenes/cornell_box.gltf");
+  s.timeBudget = 0.3;
+  const RenderJobResult r = runRenderJob(s);
+  EXPECT_GE(r.spp, 1);
+  EXPECT_GE(r.seconds, 0.3);
+  EXPECT_LT(r.seconds, 3.0);
+  EXPECT_GT(r.rays, 0u);
+  EXPECT_LE(r.firstImageSeconds, r.seconds);
+}
+
+TEST(RenderJob, BadSettingsAreInputErrors) {
+  RenderJobSettings s = small(test::sourceDir() + "/scenes/cornell_box.gltf");
+  s.width = 0;
+  EXPECT_THROW(runRenderJob(s), InputError);
+  s = small(test::sourceDir() + "/scenes/does_not_exist.gltf");
+  EXPECT_THROW(runRenderJob(s), InputError);
+  s = small(test::sourceDir() + "/scenes/cornell_box.gltf");
+  s.tracer.maxDepth = 0;
+  EXPECT_THROW(runRenderJob(s), InputError);
+}
+
+TEST(RenderJob, CornellBoxMeanIsStableAcrossSeedsAtHighSpp) {
+  // The image mean converges: two independent 64 spp renders agree to about 1%.
+  RenderJobSettings s = small(test::sourceDir() + "/scenes/cornell_box.gltf");
+  s.spp = 64;
+  s.seed = 1;
+  const glm::dvec3 a = meanRgb(runRenderJob(s).image);
+  s.seed = 99;
+  const glm::dvec3 b = meanRgb(runRenderJob(s).image);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], 0.02 * a[c]) << "channel " << c;
+}
+
+}  // namespace
+}  // namespace vpl
