@@ -71,7 +71,7 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, const std::funct
 
   const Camera camera(defaultCamera(scene.data()), settings.width, settings.height);
   const PathTracer tracer(scene, settings.tracer);
-  const TileRenderer renderer(scene, camera, tracer, settings.seed, nullptr);
+  const TileRenderer renderer(camera, settings.seed, pathTracerShader(tracer));
   Film film(settings.width, settings.height);
 
   const auto renderStart = Clock::now();

@@ -6,13 +6,19 @@
 
 namespace vpl {
 
-TileRenderer::TileRenderer(const RenderScene& scene, const Camera& camera, const PathTracer& tracer, uint64_t seed,
-                           ContinuationFactory continuation)
-    : scene_(scene), camera_(camera), tracer_(tracer), seed_(seed), continuation_(std::move(continuation)),
-      tilesX_((camera.width() + kTileSize - 1) / kTileSize), tilesY_((camera.height() + kTileSize - 1) / kTileSize) {
-  if (!continuation_)
-    continuation_ = [](uint32_t, uint64_t) { return std::make_unique<BsdfContinuation>(); };
+PixelShaderFactory pathTracerShader(const PathTracer& tracer, ContinuationFactory continuation) {
+  if (!continuation) continuation = [](uint32_t, uint64_t) { return std::make_unique<BsdfContinuation>(); };
+  return [&tracer, continuation](uint32_t tile, uint64_t pass) -> PixelShader {
+    std::shared_ptr<ContinuationSampler> strategy = continuation(tile, pass);
+    return [&tracer, strategy](const Ray& ray, uint64_t, Rng& rng, PathStats& stats) {
+      return tracer.radiance(ray, rng, *strategy, stats);
+    };
+  };
 }
+
+TileRenderer::TileRenderer(const Camera& camera, uint64_t seed, PixelShaderFactory shader)
+    : camera_(camera), seed_(seed), shader_(std::move(shader)),
+      tilesX_((camera.width() + kTileSize - 1) / kTileSize), tilesY_((camera.height() + kTileSize - 1) / kTileSize) {}
 
 PassStats TileRenderer::renderPass(Film& film, uint64_t pass, const std::atomic<bool>* stop) const {
   tbb::combinable<PassStats> perThread;
@@ -21,7 +27,7 @@ PassStats TileRenderer::renderPass(Film& film, uint64_t pass, const std::atomic<
     if (stop && stop->load(std::memory_order_relaxed)) return;
     PassStats& stats = perThread.local();
     PathStats path;
-    auto continuation = continuation_(uint32_t(tile), pass);
+    const PixelShader shade = shader_(uint32_t(tile), pass);
     const int x0 = (tile % tilesX_) * kTileSize, y0 = (tile / tilesX_) * kTileSize;
     const int x1 = std::min(x0 + kTileSize, width), y1 = std::min(y0 + kTileSize, height);
     for (int y = y0; y < y1; ++y)
@@ -30,7 +36,7 @@ PassStats TileRenderer::renderPass(Film& film, uint64_t pass, const std::atomic<
         Rng rng = Rng::forSample(seed_, pixel, pass);
         const glm::vec2 jitter = rng.uniform2();
         const Ray ray = camera_.generateRay(glm::vec2(float(x), float(y)) + jitter);
-        const glm::vec3 L = tracer_.radiance(ray, rng, *continuation, path);
+        const glm::vec3 L = shade(ray, pixel, rng, path);
         ++stats.samples;
         if (!isFiniteNonNegative(L)) {
           ++stats.discarded;

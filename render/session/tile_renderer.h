@@ -23,16 +23,21 @@ struct PassStats {
   }
 };
 
-// Makes the continuation strategy of one tile (each tile gets its own, so per-tile state such as
-// Markov chains is deterministic and never shared between threads).
+// Radiance along one camera ray of pixel `pixel` (row-major index).
+using PixelShader = std::function<glm::vec3(const Ray& ray, uint64_t pixel, Rng& rng, PathStats& stats)>;
+// Makes the shader of one tile and pass. Each tile gets its own, so per-tile state (such as Markov
+// chains) is deterministic and never shared between threads.
+using PixelShaderFactory = std::function<PixelShader(uint32_t tileIndex, uint64_t pass)>;
+
+// The path tracer as a pixel shader, with a continuation strategy per tile (nullptr: BSDF sampling).
 using ContinuationFactory = std::function<std::unique_ptr<ContinuationSampler>(uint32_t tileIndex, uint64_t pass)>;
+PixelShaderFactory pathTracerShader(const PathTracer& tracer, ContinuationFactory continuation = nullptr);
 
 class TileRenderer {
  public:
   static constexpr int kTileSize = 16;
 
-  TileRenderer(const RenderScene& scene, const Camera& camera, const PathTracer& tracer, uint64_t seed,
-               ContinuationFactory continuation);
+  TileRenderer(const Camera& camera, uint64_t seed, PixelShaderFactory shader);
 
   // Adds one sample per pixel to film. Stops early (between tiles) when *stop becomes true.
   PassStats renderPass(Film& film, uint64_t pass, const std::atomic<bool>* stop = nullptr) const;
@@ -40,11 +45,9 @@ class TileRenderer {
   int tileCount() const { return tilesX_ * tilesY_; }
 
  private:
-  const RenderScene& scene_;
   Camera camera_;
-  const PathTracer& tracer_;
   uint64_t seed_;
-  ContinuationFactory continuation_;
+  PixelShaderFactory shader_;
   int tilesX_, tilesY_;
 };
 

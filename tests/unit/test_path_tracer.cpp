@@ -22,7 +22,7 @@ Rendered renderScene(const RenderScene& scene, int width, int height, int spp, u
   PathTracerSettings settings;
   settings.maxDepth = maxDepth;
   const PathTracer tracer(scene, settings);
-  const TileRenderer renderer(scene, camera, tracer, seed, nullptr);
+  const TileRenderer renderer(camera, seed, pathTracerShader(tracer));
   Film film(width, height);
   Rendered r;
   for (int pass = 0; pass < spp; ++pass) r.stats += renderer.renderPass(film, uint64_t(pass));

@@ -1,0 +1,252 @@
+#include "render/cluster/light_slice.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <numeric>
+#include <queue>
+#include <tbb/parallel_for.h>
+#include "render/sampling/distribution_1d.h"
+#include "render/sampling/rng.h"
+
+namespace vpl {
+
+std::string LightSliceSettings::validate() const {
+  if (globalClusters < 1) return "global cluster count must be at least 1";
+  if (clusterBudget < 1) return "cluster budget must be at least 1";
+  if (reducedRows < 1) return "reduced matrix rows must be at least 1";
+  if (refinementRows < 1) return "refinement rows must be at least 1";
+  return {};
+}
+
+namespace {
+
+// Columns of the reduced light matrix restricted to a set of rows: x_j = (M[r][j])_r.
+struct Columns {
+  const std::vector<float>& matrix;  // rows x vplCount, row-major
+  size_t vplCount;
+  std::span<const uint32_t> rows;
+
+  float at(uint32_t row, uint32_t vpl) const { return matrix[size_t(row) * vplCount + vpl]; }
+  float norm(uint32_t vpl) const {
+    float s = 0.0f;
+    for (uint32_t r : rows) s += at(r, vpl) * at(r, vpl);
+    return std::sqrt(s);
+  }
+  // Cosine between two columns (1 when either is zero, so zero columns never drive a split).
+  float cosine(uint32_t a, uint32_t b, float na, float nb) const {
+    if (na <= 0.0f || nb <= 0.0f) return 1.0f;
+    float d = 0.0f;
+    for (uint32_t r : rows) d += at(r, a) * at(r, b);
+    return d / (na * nb);
+  }
+  // Matrix row-column sampling cost (Hašan et al. 2007, §4.1): sum over member pairs of
+  // |x_i||x_j| |x_i/|x_i| - x_j/|x_j||^2 = 2 (sum |x_i|)^2 - 2 |sum x_i|^2.
+  double cost(std::span<const uint32_t> members) const {
+    double sumNorm = 0.0, sum2 = 0.0;
+    for (uint32_t r : rows) {
+      double s = 0.0;
+      for (uint32_t j : members) s += at(r, j);
+      sum2 += s * s;
+    }
+    for (uint32_t j : members) sumNorm += norm(j);
+    return std::max(0.0, 2.0 * sumNorm * sumNorm - 2.0 * sum2);
+  }
+};
+
+// Two-way split of a cluster: pick two far-apart members in normalised column space and give every
+// member to the nearer one; members that are zero on these rows go by VPL position.
+bool splitCluster(const Columns& cols, std::span<const Vpl> vpls, std::vector<uint32_t>& members,
+                  std::vector<uint32_t>& left, std::vector<uint32_t>& right) {
+  if (members.size() < 2) return false;
+  std::vector<float> norms(members.size());
+  size_t pivot = 0;
+  for (size_t i = 0; i < members.size(); ++i) {
+    norms[i] = cols.norm(members[i]);
+    if (norms[i] > norms[pivot]) pivot = i;
+  }
+  auto farthest = [&](size_t from) {
+    size_t best = from;
+    float bestCos = 2.0f;
+    for (size_t i = 0; i < members.size(); ++i) {
+      const float c = cols.cosine(members[from], members[i], norms[from], norms[i]);
+      if (c < bestCos) {
+        bestCos = c;
+        best = i;
+      }
+    }
+    return best;
+  };
+  const size_t b = farthest(pivot), c = farthest(b);
+  left.clear();
+  right.clear();
+  if (b != c && norms[b] > 0.0f && norms[c] > 0.0f) {
+    for (size_t i = 0; i < members.size(); ++i) {
+      if (norms[i] <= 0.0f) continue;
+      const float cb = cols.cosine(members[i], members[b], norms[i], norms[b]);
+      const float cc = cols.cosine(members[i], members[c], norms[i], norms[c]);
+      (cb >= cc ? left : right).push_back(members[i]);
+    }
+  }
+  // Zero columns, or columns all alike: split by position along the longest axis of the members.
+  std::vector<uint32_t> rest;
+  for (size_t i = 0; i < members.size(); ++i)
+    if (norms[i] <= 0.0f || left.empty() || right.empty()) rest.push_back(members[i]);
+  if (left.empty() || right.empty()) {
+    left.clear();
+    right.clear();
+  }
+  if (!rest.empty()) {
+    glm::vec3 lo(INFINITY), hi(-INFINITY);
+    for (uint32_t j : rest) {
+      lo = glm::min(lo, vpls[j].position);
+      hi = glm::max(hi, vpls[j].position);
+    }
+    const glm::vec3 ext = hi - lo;
+    const int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
+    const size_t mid = rest.size() / 2;
+    std::nth_element(rest.begin(), rest.begin() + mid, rest.end(),
+                     [&](uint32_t a, uint32_t b2) { return vpls[a].position[axis] < vpls[b2].position[axis]; });
+    if (left.empty() && right.empty()) {
+      left.assign(rest.begin(), rest.begin() + mid);
+      right.assign(rest.begin() + mid, rest.end());
+    } else {
+      // Zero columns join the side whose first member is nearer in space.
+      const glm::vec3 pl = vpls[left.front()].position, pr = vpls[right.front()].position;
+      for (uint32_t j : rest)
+        (glm::distance(vpls[j].position, pl) <= glm::distance(vpls[j].position, pr) ? left : right).push_back(j);
+    }
+  }
+  return !left.empty() && !right.empty();
+}
+
+}  // namespace
+
+LightSliceResult clusterLightSlice(std::span<const Vpl> vpls, std::span<const GatherPoint> points, const SliceTree& tree,
+                                   const LightTransport& transport, const LightSliceSettings& settings) {
+  LightSliceResult result;
+  const uint32_t n = uint32_t(vpls.size()), sliceCount = uint32_t(tree.slices.size());
+  result.slices.resize(sliceCount);
+  if (n == 0 || sliceCount == 0) return result;
+  std::atomic<uint64_t> evaluations{0};
+
+  // 1. Reduced light matrix: rows at evenly spread slices (a seeded stride through the slices).
+  const uint32_t rowCount = std::min<uint32_t>(uint32_t(settings.reducedRows), sliceCount);
+  std::vector<uint32_t> rowSlice(rowCount);
+  Rng rowRng(settings.seed, 0x726f7773ull);
+  const double stride = double(sliceCount) / rowCount;
+  for (uint32_t r = 0; r < rowCount; ++r)
+    rowSlice[r] = std::min(sliceCount - 1, uint32_t((r + rowRng.uniform()) * stride));
+  std::vector<float> matrix(size_t(rowCount) * n);
+  tbb::parallel_for(uint32_t(0), rowCount * ((n + 1023) / 1024), [&](uint32_t task) {
+    const uint32_t r = task % rowCount, j0 = (task / rowCount) * 1024, j1 = std::min(n, j0 + 1024);
+    for (uint32_t j = j0; j < j1; ++j) matrix[size_t(r) * n + j] = transport.contribution(rowSlice[r], j, true);
+    evaluations += j1 - j0;
+  });
+
+  // 2. Global clustering over all reduced rows: seeds drawn by column norm, every column joins the
+  //    seed it is most aligned with (MRCS's sampling clustering); zero columns form one more cluster.
+  std::vector<uint32_t> allRows(rowCount);
+  std::iota(allRows.begin(), allRows.end(), 0u);
+  const Columns global{matrix, n, allRows};
+  std::vector<float> norms(n);
+  tbb::parallel_for(uint32_t(0), n, [&](uint32_t j) { norms[j] = global.norm(j); });
+  std::vector<uint32_t> seeds;
+  {
+    const Distribution1D byNorm(norms);
+    Rng rng(settings.seed, 0x73656564ull);
+    std::vector<bool> taken(n, false);
+    for (int k = 0; k < 4 * settings.globalClusters && int(seeds.size()) < settings.globalClusters && !byNorm.empty(); ++k) {
+      const uint32_t j = uint32_t(byNorm.sample(rng.uniform()));
+      if (!taken[j]) {
+        taken[j] = true;
+        seeds.push_back(j);
+      }
+    }
+  }
+  std::vector<uint32_t> globalOf(n, uint32_t(seeds.size()));  // seeds.size() = the zero-column cluster
+  tbb::parallel_for(uint32_t(0), n, [&](uint32_t j) {
+    if (norms[j] <= 0.0f) return;
+    float best = -2.0f;
+    for (uint32_t s = 0; s < seeds.size(); ++s) {
+      const float c = global.cosine(j, seeds[s], norms[j], norms[seeds[s]]);
+      if (c > best) {
+        best = c;
+        globalOf[j] = s;
+      }
+    }
+  });
+  std::vector<std::vector<uint32_t>> globalClusters(seeds.size() + 1);
+  for (uint32_t j = 0; j < n; ++j) globalClusters[globalOf[j]].push_back(j);
+  std::erase_if(globalClusters, [](const auto& c) { return c.empty(); });
+  result.globalClusterCount = uint32_t(globalClusters.size());
+
+  // 3. Per-slice refinement on the reduced rows nearest the slice's representative (6D distance).
+  const float scale = tree.normalScale;
+  auto embedDistance = [&](uint32_t a, uint32_t b) {
+    const GatherPoint &p = points[a], &q = points[b];
+    const glm::vec3 dp = p.position - q.position, dn = (p.normal - q.normal) * scale;
+    return glm::dot(dp, dp) + glm::dot(dn, dn);
+  };
+  const uint32_t k = std::min<uint32_t>(uint32_t(settings.refinementRows), rowCount);
+  tbb::parallel_for(uint32_t(0), sliceCount, [&](uint32_t s) {
+    const uint32_t rep = tree.slices[s].representative;
+    std::vector<std::pair<float, uint32_t>> byDistance(rowCount);
+    for (uint32_t r = 0; r < rowCount; ++r) byDistance[r] = {embedDistance(rep, tree.slices[rowSlice[r]].representative), r};
+    std::partial_sort(byDistance.begin(), byDistance.begin() + k, byDistance.end());
+    std::vector<uint32_t> rows(k);
+    for (uint32_t i = 0; i < k; ++i) rows[i] = byDistance[i].second;
+    const Columns local{matrix, n, rows};
+
+    struct Entry {
+      double cost;
+      uint32_t index;
+      bool operator<(const Entry& o) const { return cost < o.cost || (cost == o.cost && index > o.index); }
+    };
+    std::vector<std::vector<uint32_t>> clusters = globalClusters;
+    std::priority_queue<Entry> queue;
+    for (uint32_t c = 0; c < clusters.size(); ++c) queue.push({local.cost(clusters[c]), c});
+    std::vector<uint32_t> left, right;
+    while (int(clusters.size()) < settings.clusterBudget && !queue.empty()) {
+      const Entry top = queue.top();
+      queue.pop();
+      if (top.cost <= 0.0 && clusters[top.index].size() < 2) continue;
+      if (!splitCluster(local, vpls, clusters[top.index], left, right)) continue;
+      clusters[top.index] = left;
+      clusters.push_back(right);
+      queue.push({local.cost(clusters[top.index]), top.index});
+      queue.push({local.cost(clusters.back()), uint32_t(clusters.size() - 1)});
+    }
+
+    // Representatives by power, and their estimated contribution (with visibility) at this slice.
+    SliceClusters& out = result.slices[s];
+    out.clusters.resize(clusters.size());
+    Rng rng(settings.seed ^ 0x636c7573ull, s);
+    uint64_t evals = 0;
+    for (size_t c = 0; c < clusters.size(); ++c) {
+      VplCluster& cl = out.clusters[c];
+      std::vector<float> power(clusters[c].size());
+      for (size_t i = 0; i < clusters[c].size(); ++i) {
+        const Vpl& v = vpls[clusters[c][i]];
+        cl.totalFlux += v.flux;
+        power[i] = v.power();
+        cl.totalPower += power[i];
+      }
+      const Distribution1D pick(power);
+      cl.representative = pick.empty() ? clusters[c][0] : clusters[c][pick.sample(rng.uniform())];
+      const float repPower = vpls[cl.representative].power();
+      cl.estimate = repPower > 0.0f ? transport.contribution(s, cl.representative, true) * (cl.totalPower / repPower) : 0.0f;
+      ++evals;
+      if (settings.keepMembers) {
+        cl.memberBegin = uint32_t(out.members.size());
+        out.members.insert(out.members.end(), clusters[c].begin(), clusters[c].end());
+        cl.memberEnd = uint32_t(out.members.size());
+      }
+    }
+    evaluations += evals;
+  });
+  result.evaluations = evaluations.load();
+  return result;
+}
+
+}  // namespace vpl
