@@ -37,6 +37,11 @@ nlohmann::ordered_json summaryJson(const RenderJobSettings& s, const RenderJobRe
   j["bsdf_samples"] = r.bsdfSamples;
   j["guide_samples"] = r.guideSamples;
   j["triangles"] = r.triangles;
+  if (s.mode == SamplingMode::Preview) {
+    j["vpls"] = r.vplCount;
+    j["slices"] = r.sliceCount;
+    j["clusters_per_slice"] = r.clustersPerSlice;
+  }
   j["seed"] = s.seed;
   j["threads"] = tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
   j["scene"] = s.scenePath;

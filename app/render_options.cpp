@@ -48,6 +48,16 @@ void RenderOptions::addTo(CLI::App& command, bool requireOut) {
   if (requireOut) outOpt->required();
   command.add_option("--png", png, "also write an sRGB PNG");
   command.add_option("--exposure", exposure, "PNG exposure in stops");
+  command.add_option("--vpls", preview.vpl.count, "number of VPLs")->check(CLI::Range(0, 50'000'000));
+  command.add_option("--slice-size", preview.slices.maxSliceSize, "largest slice, in gather points")->check(CLI::Range(1, 1 << 24));
+  command.add_option("--normal-scale", preview.slices.normalScale, "6D kd-tree normal weight (0: scene diagonal / 16)")
+      ->check(CLI::NonNegativeNumber);
+  command.add_option("--global-clusters", preview.clustering.globalClusters, "LightSlice global clusters")->check(CLI::Range(1, 1 << 20));
+  command.add_option("--clusters", preview.clustering.clusterBudget, "VPL clusters per slice (budget)")->check(CLI::Range(1, 1 << 20));
+  command.add_option("--vpl-clamp", preview.clampFraction, "geometry clamp distance as a fraction of the scene diagonal")
+      ->check(CLI::Range(0.0f, 0.99f));
+  command.add_option("--clusters-per-pass", preview.clustersPerPass, "clusters sampled per pixel and preview pass")
+      ->check(CLI::Range(1, 1 << 16));
 }
 
 RenderJobSettings RenderOptions::toSettings() const {
@@ -60,6 +70,7 @@ RenderJobSettings RenderOptions::toSettings() const {
   s.spp = spp > 0 ? spp : 16;
   s.timeBudget = time;
   s.tracer.maxDepth = maxDepth;
+  s.preview = preview;
   if (!sky.empty()) {
     s.sky.explicitSky = true;
     s.sky.radiance = parseSky(sky);

@@ -19,6 +19,7 @@ struct RenderOptions {
   std::string sky;  // "R,G,B", "0", or empty (automatic)
   float exposure = 0.0f;
   double rawSeconds = 3.0;  // bench only
+  PreviewSettings preview;  // VPL, slice and cluster flags
 
   void addTo(CLI::App& command, bool requireOut);
   // Checked conversion; throws InputError for values CLI11 cannot check alone.

@@ -47,12 +47,13 @@ std::string RenderJobSettings::validate() const {
   if (timeBudget <= 0.0 && spp < 1) return "spp must be at least 1";
   if (timeBudget > 0.0 && !(timeBudget < 1e7)) return "time budget is too large";
   if (std::string e = tracer.validate(); !e.empty()) return e;
+  if (std::string e = preview.validate(); !e.empty()) return e;
   return {};
 }
 
 RenderJobResult runRenderJob(const RenderJobSettings& settings, const std::function<void(double)>& progress) {
   if (std::string e = settings.validate(); !e.empty()) throw InputError(e);
-  if (settings.mode != SamplingMode::Brdf)
+  if (settings.mode != SamplingMode::Brdf && settings.mode != SamplingMode::Preview)
     throw InputError(std::string("mode '") + modeName(settings.mode) + "' is not available in this build yet");
 
   RenderJobResult result;
@@ -71,7 +72,32 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, const std::funct
 
   const Camera camera(defaultCamera(scene.data()), settings.width, settings.height);
   const PathTracer tracer(scene, settings.tracer);
-  const TileRenderer renderer(camera, settings.seed, pathTracerShader(tracer));
+  // VPLs (camera-independent), then slices and clusters for this camera.
+  VplField field;
+  PixelShaderFactory shader;
+  if (settings.mode == SamplingMode::Preview) {
+    auto t = Clock::now();
+    VplSettings vplSettings = settings.preview.vpl;
+    vplSettings.seed = settings.seed;
+    auto vpls = std::make_shared<VplSet>(traceVpls(scene, vplSettings));
+    result.timings.vpl = secondsSince(t);
+    result.rays += vpls->rays;
+    result.vplCount = vpls->vpls.size();
+    t = Clock::now();
+    PreviewSettings preview = settings.preview;
+    preview.clustering.seed = settings.seed;
+    field = buildVplField(scene, camera, vpls, preview);
+    result.timings.cluster = secondsSince(t);
+    result.rays += field.rays;
+    result.sliceCount = field.tree.slices.size();
+    size_t clusterTotal = 0;
+    for (const SliceClusters& s : field.clusters.slices) clusterTotal += s.clusters.size();
+    result.clustersPerSlice = field.tree.slices.empty() ? 0.0 : double(clusterTotal) / double(field.tree.slices.size());
+    shader = previewShader(scene, field, settings.preview);
+  } else {
+    shader = pathTracerShader(tracer);
+  }
+  const TileRenderer renderer(camera, settings.seed, shader);
   Film film(settings.width, settings.height);
 
   const auto renderStart = Clock::now();

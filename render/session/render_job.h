@@ -9,6 +9,7 @@
 #include "render/integrator/path_tracer.h"
 #include "render/integrator/sampling_mode.h"
 #include "render/scene/render_scene.h"
+#include "render/vpl/vpl_preview.h"
 
 namespace vpl {
 
@@ -20,6 +21,7 @@ struct RenderJobSettings {
   int spp = 16;               // used when timeBudget <= 0
   double timeBudget = 0.0;    // seconds after load (BVH, VPLs, clustering and rendering all count)
   PathTracerSettings tracer;
+  PreviewSettings preview;  // VPLs, slices and clusters (preview and guided modes)
   SkySettings sky;
 
   std::string validate() const;  // empty when valid
@@ -37,6 +39,8 @@ struct RenderJobResult {
   PhaseTimings timings;
   uint64_t rays = 0, samples = 0, discarded = 0, bsdfSamples = 0, guideSamples = 0;
   size_t triangles = 0;
+  size_t vplCount = 0, sliceCount = 0;
+  double clustersPerSlice = 0.0;
   std::vector<std::string> notices;
 };
 

@@ -1,0 +1,127 @@
+#include "render/vpl/vpl_preview.h"
+
+#include <cmath>
+#include "render/core/color.h"
+
+namespace vpl {
+
+std::string PreviewSettings::validate() const {
+  if (std::string e = vpl.validate(); !e.empty()) return e;
+  if (std::string e = slices.validate(); !e.empty()) return e;
+  if (std::string e = clustering.validate(); !e.empty()) return e;
+  if (!(clampFraction >= 0.0f && clampFraction < 1.0f)) return "VPL clamp fraction must be in [0, 1)";
+  if (clustersPerPass < 1) return "clusters per pass must be at least 1";
+  return {};
+}
+
+namespace {
+
+bool vplVisible(const RenderScene& scene, const SurfaceHit& at, const Vpl& light, PathStats* stats = nullptr) {
+  const glm::vec3 d = light.position - at.position;
+  const float dist = glm::length(d);
+  if (!(dist > 0.0f)) return false;
+  const glm::vec3 wi = d / dist;
+  if (glm::dot(wi, at.geometricNormal) <= 0.0f) return false;
+  if (stats) ++stats->rays;
+  return !scene.accel().occluded(spawnShadowRay(at, wi, dist));
+}
+
+// The light matrix entries LightSlice samples: VPL j seen from slice i's representative.
+class SliceTransport final : public LightTransport {
+ public:
+  SliceTransport(const RenderScene& scene, const VplField& field) : scene_(scene), field_(field) {
+    bsdfs_.reserve(field.tree.slices.size());
+    for (const Slice& s : field.tree.slices) bsdfs_.push_back(scene.bsdf(field.gather.hits[s.representative]));
+  }
+  float contribution(uint32_t slice, uint32_t vplIndex, bool visible) const override {
+    const uint32_t g = field_.tree.slices[slice].representative;
+    const SurfaceHit& hit = field_.gather.hits[g];
+    const Vpl& light = field_.vpls->vpls[vplIndex];
+    const float l = luminance(vplContribution(light, hit.position, bsdfs_[slice], field_.gather.wo[g], field_.minDistance));
+    if (!(l > 0.0f) || !std::isfinite(l)) return 0.0f;
+    if (visible && !vplVisible(scene_, hit, light)) return 0.0f;
+    return l;
+  }
+
+ private:
+  const RenderScene& scene_;
+  const VplField& field_;
+  std::vector<Bsdf> bsdfs_;
+};
+
+}  // namespace
+
+VplField buildVplField(const RenderScene& scene, const Camera& camera, std::shared_ptr<const VplSet> vpls,
+                       const PreviewSettings& settings) {
+  VplField field;
+  field.vpls = std::move(vpls);
+  field.gather = gatherPrimaryHits(scene, camera);
+  const float diagonal = 2.0f * scene.radius();
+  field.tree = buildSliceTree(field.gather.points, settings.slices, diagonal);
+  field.minDistance = settings.clampFraction * diagonal;
+  const SliceTransport transport(scene, field);
+  field.clusters = clusterLightSlice(field.vpls->vpls, field.gather.points, field.tree, transport, settings.clustering);
+  field.rays = field.gather.rays + field.clusters.evaluations;
+
+  // Which cluster a preview pass samples: by estimated contribution, with a defensive share so that
+  // clusters whose representative is hidden from the slice's centre still get sampled elsewhere in it.
+  field.clusterChoice.resize(field.clusters.slices.size());
+  for (size_t s = 0; s < field.clusters.slices.size(); ++s) {
+    const auto& clusters = field.clusters.slices[s].clusters;
+    std::vector<float> w(clusters.size());
+    double sum = 0.0;
+    for (const VplCluster& c : clusters) sum += c.estimate;
+    const float mean = clusters.empty() ? 0.0f : float(sum / double(clusters.size()));
+    for (size_t c = 0; c < clusters.size(); ++c)
+      w[c] = mean > 0.0f ? clusters[c].estimate + 0.1f * mean : clusters[c].totalPower;
+    field.clusterChoice[s] = Distribution1D(w);
+  }
+  return field;
+}
+
+PixelShaderFactory previewShader(const RenderScene& scene, const VplField& field, const PreviewSettings& settings) {
+  const int m = settings.clustersPerPass;
+  return [&scene, &field, m](uint32_t, uint64_t) -> PixelShader {
+    return [&scene, &field, m](const Ray& ray, uint64_t pixel, Rng& rng, PathStats& stats) -> glm::vec3 {
+      const EmitterSet& emitters = scene.emitters();
+      const RayHit hit = scene.accel().intersect(ray);
+      ++stats.rays;
+      if (!hit.valid()) return emitters.hasSky() ? emitters.sky() : glm::vec3(0.0f);
+      const SurfaceHit surface = scene.surface(ray, hit);
+      const glm::vec3 wo = -ray.direction;
+      glm::vec3 L = emitters.emitted(surface, wo);
+      const Bsdf bsdf = scene.bsdf(surface);
+
+      // Direct light: one emitter sample.
+      if (const auto ls = emitters.sample(surface.position, rng.uniform(), rng.uniform2())) {
+        const glm::vec3 f = bsdf.eval(wo, ls->wi);
+        if (!isBlack(f) && glm::dot(ls->wi, surface.geometricNormal) > 0.0f) {
+          ++stats.rays;
+          if (!scene.accel().occluded(spawnShadowRay(surface, ls->wi, ls->distance))) L += f * ls->radiance / ls->pdf;
+        }
+      }
+
+      // Indirect light: clusters of the pixel's slice, sampled by estimated contribution.
+      const int32_t g = pixel < field.gather.pixelGather.size() ? field.gather.pixelGather[pixel] : -1;
+      if (g < 0) return L;
+      const uint32_t s = field.tree.sliceOf[size_t(g)];
+      const Distribution1D& choice = field.clusterChoice[s];
+      if (choice.empty()) return L;
+      const auto& clusters = field.clusters.slices[s].clusters;
+      for (int i = 0; i < m; ++i) {
+        float pmf = 0.0f;
+        const VplCluster& c = clusters[choice.sample(rng.uniform(), &pmf)];
+        const Vpl& light = field.vpls->vpls[c.representative];
+        const float repPower = light.power();
+        if (!(repPower > 0.0f)) continue;
+        const glm::vec3 contribution =
+            vplContribution(light, surface.position, bsdf, wo, field.minDistance) * (c.totalPower / repPower);
+        if (isBlack(contribution)) continue;
+        if (vplVisible(scene, surface, light, &stats)) L += contribution / (float(m) * pmf);
+      }
+      return L;
+    };
+  };
+}
+
+}  // namespace vpl

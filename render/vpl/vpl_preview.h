@@ -1,0 +1,51 @@
+// The instant-radiosity preview (DESIGN.md §2 steps 2–5): VPLs, slices of gather points, LightSlice
+// clusters per slice, and a pixel shader that adds direct light (emitter sampling) to the indirect
+// light of the pixel's slice clusters. Each pass draws a few clusters per pixel in proportion to
+// their estimated contribution, so passes average to the full clustered sum: a coarse image at once,
+// sharper with every pass.
+//
+// Parameters (PreviewSettings):
+//   vpl.count            int    32768  VPLs (see VplSettings)
+//   slices.*                            see SliceSettings
+//   clustering.*                        see LightSliceSettings
+//   clampFraction        float  0.01   geometry-term clamp: 1/d^2 <= 1/(clampFraction x scene diagonal)^2
+//   clustersPerPass      int    16     clusters sampled per pixel and pass
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+#include "render/cluster/light_slice.h"
+#include "render/sampling/distribution_1d.h"
+#include "render/session/tile_renderer.h"
+#include "render/vpl/gather.h"
+#include "render/vpl/vpl_tracer.h"
+
+namespace vpl {
+
+struct PreviewSettings {
+  VplSettings vpl;
+  SliceSettings slices;
+  LightSliceSettings clustering;
+  float clampFraction = 0.01f;
+  int clustersPerPass = 16;
+  std::string validate() const;
+};
+
+// Everything the preview and the guide build for one camera (VPLs are the camera-independent part).
+struct VplField {
+  std::shared_ptr<const VplSet> vpls;
+  CameraGather gather;
+  SliceTree tree;
+  LightSliceResult clusters;
+  std::vector<Distribution1D> clusterChoice;  // per slice: which cluster a pass samples
+  float minDistance = 0.0f;                   // geometry-term clamp distance (world units)
+  uint64_t rays = 0;
+};
+
+// The camera-dependent part; `vpls` is reused across camera moves.
+VplField buildVplField(const RenderScene& scene, const Camera& camera, std::shared_ptr<const VplSet> vpls,
+                       const PreviewSettings& settings);
+
+PixelShaderFactory previewShader(const RenderScene& scene, const VplField& field, const PreviewSettings& settings);
+
+}  // namespace vpl

@@ -1,0 +1,100 @@
+#include "render/vpl/vpl_tracer.h"
+
+#include <algorithm>
+#include <tbb/parallel_for.h>
+#include "render/core/color.h"
+#include "render/sampling/rng.h"
+
+namespace vpl {
+
+std::string VplSettings::validate() const {
+  if (count < 0 || count > 50'000'000) return "VPL count must be between 0 and 50,000,000";
+  if (maxDepth < 1 || maxDepth > 256) return "VPL path depth must be between 1 and 256";
+  return {};
+}
+
+namespace {
+
+struct PathResult {
+  std::vector<Vpl> vpls;
+  uint64_t rays = 0;
+};
+
+// One light path; VPL fluxes are left un-normalised (divided by the path count at the end).
+void traceLightPath(const RenderScene& scene, const VplSettings& settings, uint64_t pathIndex, PathResult& out) {
+  Rng rng(settings.seed ^ 0x5bd1e995ull, pathIndex);
+  const float uLight = rng.uniform();
+  const glm::vec2 uPos = rng.uniform2(), uDir = rng.uniform2();
+  const auto emission = scene.emitters().sampleEmission(uLight, uPos, uDir);
+  if (!emission || !isFiniteNonNegative(emission->weight) || isBlack(emission->weight)) return;
+
+  glm::vec3 beta = emission->weight;
+  Ray ray;
+  ray.origin = emission->normal == glm::vec3(0.0f) ? emission->position
+                                                   : offsetRayOrigin(emission->position, emission->normal);
+  ray.direction = emission->direction;
+  for (int depth = 1; depth <= settings.maxDepth; ++depth) {
+    const RayHit hit = scene.accel().intersect(ray);
+    ++out.rays;
+    if (!hit.valid()) break;
+    const SurfaceHit surface = scene.surface(ray, hit);
+    const Bsdf bsdf = scene.bsdf(surface);
+    const glm::vec3 wo = -ray.direction;
+    if (!bsdf.isNearSpecular()) {
+      Vpl v;
+      v.position = surface.position;
+      v.normal = surface.shadingNormal;
+      v.flux = beta;
+      v.incident = wo;
+      v.bsdf = bsdf.params();
+      v.material = surface.material;
+      v.bounce = uint16_t(std::min(depth, 65535));
+      out.vpls.push_back(v);
+    }
+    const auto s = bsdf.sample(wo, rng.uniform2(), rng.uniform());
+    if (!s) break;
+    beta *= s->weight;
+    // Russian roulette keeps VPL fluxes bounded (beta stays <= its running maximum).
+    const float survive = std::min(1.0f, maxComponent(beta) / std::max(1e-30f, maxComponent(emission->weight)));
+    if (rng.uniform() >= survive) break;
+    beta /= survive;
+    if (!isFiniteNonNegative(beta)) break;
+    ray = spawnRay(surface, s->wi);
+  }
+}
+
+}  // namespace
+
+VplSet traceVpls(const RenderScene& scene, const VplSettings& settings) {
+  VplSet set;
+  if (settings.count == 0 || scene.emitters().empty()) return set;
+  constexpr uint64_t kBatch = 1024;
+  // Batches are traced in parallel and appended in path order: the result is independent of threads.
+  while (set.vpls.size() < size_t(settings.count) && set.lightPaths < 64ull * uint64_t(settings.count) + kBatch) {
+    std::vector<PathResult> batch(kBatch);
+    tbb::parallel_for(uint64_t(0), kBatch, [&](uint64_t i) { traceLightPath(scene, settings, set.lightPaths + i, batch[i]); });
+    for (PathResult& r : batch) {
+      set.rays += r.rays;
+      set.vpls.insert(set.vpls.end(), r.vpls.begin(), r.vpls.end());
+    }
+    set.lightPaths += kBatch;
+  }
+  const float inv = 1.0f / float(set.lightPaths);
+  for (Vpl& v : set.vpls) v.flux *= inv;
+  return set;
+}
+
+glm::vec3 vplContribution(const Vpl& light, const glm::vec3& x, const Bsdf& receiver, const glm::vec3& wo,
+                          float minDistance) {
+  const glm::vec3 d = light.position - x;
+  const float dist2 = glm::dot(d, d);
+  if (!(dist2 > 0.0f)) return glm::vec3(0.0f);
+  const glm::vec3 toLight = d / std::sqrt(dist2);
+  const Bsdf emitter(light.bsdf, Frame::fromNormal(light.normal));
+  // eval(wo = incident, wi = towards x) carries the cosine at the VPL; the receiver's eval carries its own.
+  const glm::vec3 leaving = emitter.eval(light.incident, -toLight);
+  const glm::vec3 arriving = receiver.eval(wo, toLight);
+  return light.flux * leaving * arriving / std::max(dist2, minDistance * minDistance);
+}
+
+}  // namespace vpl
