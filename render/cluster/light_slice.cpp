@@ -21,37 +21,46 @@ std::string LightSliceSettings::validate() const {
 
 namespace {
 
-// Columns of the reduced light matrix restricted to a set of rows: x_j = (M[r][j])_r.
-struct Columns {
-  const std::vector<float>& matrix;  // rows x vplCount, row-major
-  size_t vplCount;
-  std::span<const uint32_t> rows;
-
-  float at(uint32_t row, uint32_t vpl) const { return matrix[size_t(row) * vplCount + vpl]; }
-  float norm(uint32_t vpl) const {
-    float s = 0.0f;
-    for (uint32_t r : rows) s += at(r, vpl) * at(r, vpl);
-    return std::sqrt(s);
+// Light matrix columns restricted to some rows, stored column by column with their norms and unit
+// vectors, so the clustering's inner loops read contiguous memory.
+class Columns {
+ public:
+  Columns(std::span<const float* const> rows, uint32_t n) : dim_(rows.size()), norms_(n), unit_(size_t(n) * rows.size()) {
+    for (uint32_t j = 0; j < n; ++j) {
+      float s = 0.0f;
+      for (const float* r : rows) s += r[j] * r[j];
+      norms_[j] = std::sqrt(s);
+      const float inv = norms_[j] > 0.0f ? 1.0f / norms_[j] : 0.0f;
+      for (size_t r = 0; r < dim_; ++r) unit_[size_t(j) * dim_ + r] = rows[r][j] * inv;
+    }
   }
+  float norm(uint32_t vpl) const { return norms_[vpl]; }
   // Cosine between two columns (1 when either is zero, so zero columns never drive a split).
-  float cosine(uint32_t a, uint32_t b, float na, float nb) const {
-    if (na <= 0.0f || nb <= 0.0f) return 1.0f;
+  float cosine(uint32_t a, uint32_t b) const {
+    if (norms_[a] <= 0.0f || norms_[b] <= 0.0f) return 1.0f;
+    const float *ua = &unit_[size_t(a) * dim_], *ub = &unit_[size_t(b) * dim_];
     float d = 0.0f;
-    for (uint32_t r : rows) d += at(r, a) * at(r, b);
-    return d / (na * nb);
+    for (size_t r = 0; r < dim_; ++r) d += ua[r] * ub[r];
+    return d;
   }
   // Matrix row-column sampling cost (Hašan et al. 2007, §4.1): sum over member pairs of
   // |x_i||x_j| |x_i/|x_i| - x_j/|x_j||^2 = 2 (sum |x_i|)^2 - 2 |sum x_i|^2.
   double cost(std::span<const uint32_t> members) const {
-    double sumNorm = 0.0, sum2 = 0.0;
-    for (uint32_t r : rows) {
-      double s = 0.0;
-      for (uint32_t j : members) s += at(r, j);
-      sum2 += s * s;
+    std::vector<double> sum(dim_, 0.0);
+    double sumNorm = 0.0;
+    for (uint32_t j : members) {
+      sumNorm += norms_[j];
+      const float* u = &unit_[size_t(j) * dim_];
+      for (size_t r = 0; r < dim_; ++r) sum[r] += double(u[r]) * norms_[j];
     }
-    for (uint32_t j : members) sumNorm += norm(j);
+    double sum2 = 0.0;
+    for (double v : sum) sum2 += v * v;
     return std::max(0.0, 2.0 * sumNorm * sumNorm - 2.0 * sum2);
   }
+
+ private:
+  size_t dim_;
+  std::vector<float> norms_, unit_;
 };
 
 // Two-way split of a cluster: pick two far-apart members in normalised column space and give every
@@ -65,11 +74,12 @@ bool splitCluster(const Columns& cols, std::span<const Vpl> vpls, std::vector<ui
     norms[i] = cols.norm(members[i]);
     if (norms[i] > norms[pivot]) pivot = i;
   }
+  if (norms[pivot] <= 0.0f) pivot = 0;
   auto farthest = [&](size_t from) {
     size_t best = from;
     float bestCos = 2.0f;
     for (size_t i = 0; i < members.size(); ++i) {
-      const float c = cols.cosine(members[from], members[i], norms[from], norms[i]);
+      const float c = cols.cosine(members[from], members[i]);
       if (c < bestCos) {
         bestCos = c;
         best = i;
@@ -83,8 +93,8 @@ bool splitCluster(const Columns& cols, std::span<const Vpl> vpls, std::vector<ui
   if (b != c && norms[b] > 0.0f && norms[c] > 0.0f) {
     for (size_t i = 0; i < members.size(); ++i) {
       if (norms[i] <= 0.0f) continue;
-      const float cb = cols.cosine(members[i], members[b], norms[i], norms[b]);
-      const float cc = cols.cosine(members[i], members[c], norms[i], norms[c]);
+      const float cb = cols.cosine(members[i], members[b]);
+      const float cc = cols.cosine(members[i], members[c]);
       (cb >= cc ? left : right).push_back(members[i]);
     }
   }
@@ -145,43 +155,57 @@ LightSliceResult clusterLightSlice(std::span<const Vpl> vpls, std::span<const Ga
   });
 
   // 2. Global clustering over all reduced rows: seeds drawn by column norm, every column joins the
-  //    seed it is most aligned with (MRCS's sampling clustering); zero columns form one more cluster.
-  std::vector<uint32_t> allRows(rowCount);
-  std::iota(allRows.begin(), allRows.end(), 0u);
-  const Columns global{matrix, n, allRows};
+  //    seed it is most aligned with (MRCS's sampling clustering); columns that are zero in every
+  //    sampled row join the seed nearest in space.
+  std::vector<const float*> rowPointers(rowCount);
+  for (uint32_t r = 0; r < rowCount; ++r) rowPointers[r] = &matrix[size_t(r) * n];
+  const Columns global(rowPointers, n);
   std::vector<float> norms(n);
-  tbb::parallel_for(uint32_t(0), n, [&](uint32_t j) { norms[j] = global.norm(j); });
+  for (uint32_t j = 0; j < n; ++j) norms[j] = global.norm(j);
   std::vector<uint32_t> seeds;
   {
     const Distribution1D byNorm(norms);
     Rng rng(settings.seed, 0x73656564ull);
     std::vector<bool> taken(n, false);
-    for (int k = 0; k < 4 * settings.globalClusters && int(seeds.size()) < settings.globalClusters && !byNorm.empty(); ++k) {
+    const int wanted = std::min(settings.globalClusters, settings.clusterBudget);
+    for (int k = 0; k < 4 * wanted && int(seeds.size()) < wanted && !byNorm.empty(); ++k) {
       const uint32_t j = uint32_t(byNorm.sample(rng.uniform()));
       if (!taken[j]) {
         taken[j] = true;
         seeds.push_back(j);
       }
     }
+    if (seeds.empty()) seeds.push_back(0);  // every column is zero: one cluster to start from
   }
-  std::vector<uint32_t> globalOf(n, uint32_t(seeds.size()));  // seeds.size() = the zero-column cluster
+  std::vector<uint32_t> globalOf(n, 0);
   tbb::parallel_for(uint32_t(0), n, [&](uint32_t j) {
-    if (norms[j] <= 0.0f) return;
+    if (norms[j] <= 0.0f) {
+      float nearest = INFINITY;
+      for (uint32_t s = 0; s < seeds.size(); ++s) {
+        const float d = glm::distance(vpls[j].position, vpls[seeds[s]].position);
+        if (d < nearest) {
+          nearest = d;
+          globalOf[j] = s;
+        }
+      }
+      return;
+    }
     float best = -2.0f;
     for (uint32_t s = 0; s < seeds.size(); ++s) {
-      const float c = global.cosine(j, seeds[s], norms[j], norms[seeds[s]]);
+      const float c = global.cosine(j, seeds[s]);
       if (c > best) {
         best = c;
         globalOf[j] = s;
       }
     }
   });
-  std::vector<std::vector<uint32_t>> globalClusters(seeds.size() + 1);
+  std::vector<std::vector<uint32_t>> globalClusters(seeds.size());
   for (uint32_t j = 0; j < n; ++j) globalClusters[globalOf[j]].push_back(j);
   std::erase_if(globalClusters, [](const auto& c) { return c.empty(); });
   result.globalClusterCount = uint32_t(globalClusters.size());
 
-  // 3. Per-slice refinement on the reduced rows nearest the slice's representative (6D distance).
+  // 3. Per-slice refinement (LightSlice §4.2) on the slice's own row (its representative, unoccluded:
+  //    one cheap evaluation per VPL) and the reduced rows nearest it (6D distance, with visibility).
   const float scale = tree.normalScale;
   auto embedDistance = [&](uint32_t a, uint32_t b) {
     const GatherPoint &p = points[a], &q = points[b];
@@ -194,9 +218,11 @@ LightSliceResult clusterLightSlice(std::span<const Vpl> vpls, std::span<const Ga
     std::vector<std::pair<float, uint32_t>> byDistance(rowCount);
     for (uint32_t r = 0; r < rowCount; ++r) byDistance[r] = {embedDistance(rep, tree.slices[rowSlice[r]].representative), r};
     std::partial_sort(byDistance.begin(), byDistance.begin() + k, byDistance.end());
-    std::vector<uint32_t> rows(k);
-    for (uint32_t i = 0; i < k; ++i) rows[i] = byDistance[i].second;
-    const Columns local{matrix, n, rows};
+    std::vector<float> ownRow(n);
+    for (uint32_t j = 0; j < n; ++j) ownRow[j] = transport.contribution(s, j, false);
+    std::vector<const float*> localRows = {ownRow.data()};
+    for (uint32_t i = 0; i < k; ++i) localRows.push_back(&matrix[size_t(byDistance[i].second) * n]);
+    const Columns local(localRows, n);
 
     struct Entry {
       double cost;
@@ -222,7 +248,7 @@ LightSliceResult clusterLightSlice(std::span<const Vpl> vpls, std::span<const Ga
     SliceClusters& out = result.slices[s];
     out.clusters.resize(clusters.size());
     Rng rng(settings.seed ^ 0x636c7573ull, s);
-    uint64_t evals = 0;
+    uint64_t evals = n;
     for (size_t c = 0; c < clusters.size(); ++c) {
       VplCluster& cl = out.clusters[c];
       std::vector<float> power(clusters[c].size());
