@@ -7,6 +7,7 @@
 #include <tbb/global_control.h>
 #include "render/core/error.h"
 #include "render/film/image_io.h"
+#include "render/film/image_metrics.h"
 #include "render/session/progress_bar.h"
 #include "render/session/render_job.h"
 #include "render/session/ray_benchmark.h"
@@ -19,6 +20,8 @@ namespace {
 RenderOptions gRender, gBench;
 CLI::App* gRenderCommand = nullptr;
 CLI::App* gBenchCommand = nullptr;
+CLI::App* gCompareCommand = nullptr;
+std::string gCompareImage, gCompareReference;
 
 nlohmann::ordered_json summaryJson(const RenderJobSettings& s, const RenderJobResult& r) {
   nlohmann::ordered_json j;
@@ -37,10 +40,14 @@ nlohmann::ordered_json summaryJson(const RenderJobSettings& s, const RenderJobRe
   j["bsdf_samples"] = r.bsdfSamples;
   j["guide_samples"] = r.guideSamples;
   j["triangles"] = r.triangles;
-  if (s.mode == SamplingMode::Preview) {
+  if (s.mode != SamplingMode::Brdf) {
     j["vpls"] = r.vplCount;
-    j["slices"] = r.sliceCount;
-    j["clusters_per_slice"] = r.clustersPerSlice;
+    j[s.mode == SamplingMode::Preview ? "slices" : "cache_points"] = r.sliceCount;
+    j[s.mode == SamplingMode::Preview ? "clusters_per_slice" : "clusters_per_cache_point"] = r.clustersPerSlice;
+  }
+  if (s.mode == SamplingMode::Metropolis || s.mode == SamplingMode::Mis || s.mode == SamplingMode::Mixture) {
+    j["acceptance"] = r.proposals > 0 ? double(r.accepted) / double(r.proposals) : 0.0;
+    j["guide_bytes"] = r.guideBytes;
   }
   j["seed"] = s.seed;
   j["threads"] = tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
@@ -82,6 +89,17 @@ int runBench() {
   return 0;
 }
 
+int runCompare() {
+  const Image image = readExr(gCompareImage), reference = readExr(gCompareReference);
+  nlohmann::ordered_json j;
+  j["image"] = gCompareImage;
+  j["reference"] = gCompareReference;
+  j["relmse"] = relMse(image, reference);
+  j["bias"] = relativeBias(image, reference);
+  std::printf("%s\n", j.dump().c_str());
+  return 0;
+}
+
 }  // namespace
 
 void registerCommands(CLI::App& app) {
@@ -92,9 +110,14 @@ void registerCommands(CLI::App& app) {
   gBench.addTo(*gBenchCommand, /*requireOut=*/false);
   gBenchCommand->add_option("--raw-seconds", gBench.rawSeconds, "seconds of raw incoherent rtcIntersect1 rays")
       ->check(CLI::PositiveNumber);
+
+  gCompareCommand = app.add_subcommand("compare", "relMSE and relative bias of an EXR image against a reference EXR");
+  gCompareCommand->add_option("image", gCompareImage, "image (OpenEXR)")->required();
+  gCompareCommand->add_option("reference", gCompareReference, "reference (OpenEXR)")->required();
 }
 
 int runSelectedCommand(CLI::App& app) {
+  if (gCompareCommand->parsed()) return runCompare();
   if (gRenderCommand->parsed()) return runRender();
   if (gBenchCommand->parsed()) return runBench();
   std::fprintf(stderr, "vplview: the viewer is not built yet; use 'vplview render SCENE --out X.exr' (see --help)\n");

@@ -56,6 +56,13 @@ void RenderOptions::addTo(CLI::App& command, bool requireOut) {
   command.add_option("--clusters", preview.clustering.clusterBudget, "VPL clusters per slice (budget)")->check(CLI::Range(1, 1 << 20));
   command.add_option("--vpl-clamp", preview.clampFraction, "geometry clamp distance as a fraction of the scene diagonal")
       ->check(CLI::Range(0.0f, 0.99f));
+  command.add_option("--cone", coneDegrees, "guide cone half-angle, degrees")->check(CLI::Range(0.01f, 180.0f));
+  command.add_option("--defensive", guide.defensive, "uniform share of the guide pdf")->check(CLI::Range(1e-6f, 1.0f));
+  command.add_option("--uniform-mutation", guide.uniformMutation, "Metropolis: probability of an independent direction")
+      ->check(CLI::Range(0.0f, 1.0f));
+  command.add_option("--perturb", perturbDegrees, "Metropolis perturbation cone, degrees")->check(CLI::Range(0.01f, 180.0f));
+  command.add_option("--mutations", guide.mutations, "Metropolis steps per direction")->check(CLI::Range(1, 1000));
+  command.add_option("--bsdf-prob", guide.bsdfProbability, "mis: probability of sampling the BSDF")->check(CLI::Range(0.0f, 1.0f));
   command.add_option("--clusters-per-pass", preview.clustersPerPass, "clusters sampled per pixel and preview pass")
       ->check(CLI::Range(1, 1 << 16));
 }
@@ -71,6 +78,9 @@ RenderJobSettings RenderOptions::toSettings() const {
   s.timeBudget = time;
   s.tracer.maxDepth = maxDepth;
   s.preview = preview;
+  s.guide = guide;
+  s.guide.coneAngle = coneDegrees * 3.14159265f / 180.0f;
+  s.guide.perturbationAngle = perturbDegrees * 3.14159265f / 180.0f;
   if (!sky.empty()) {
     s.sky.explicitSky = true;
     s.sky.radiance = parseSky(sky);

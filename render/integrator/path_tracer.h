@@ -26,6 +26,7 @@ struct PathStats {
   uint64_t rays = 0;          // intersection + shadow rays
   uint64_t bsdfSamples = 0;   // continuation directions drawn from the BSDF
   uint64_t guideSamples = 0;  // continuation directions drawn from the guide
+  uint64_t proposals = 0, accepted = 0;  // Metropolis mutations
 };
 
 // How a vertex picks its continuation direction. The BSDF strategy is the reference; guided

@@ -10,6 +10,8 @@
 #include "render/scene/camera.h"
 #include "render/scene/gltf_loader.h"
 #include "render/session/tile_renderer.h"
+#include "render/guide/guide_builder.h"
+#include "render/integrator/guided_continuation.h"
 
 namespace vpl {
 
@@ -48,13 +50,12 @@ std::string RenderJobSettings::validate() const {
   if (timeBudget > 0.0 && !(timeBudget < 1e7)) return "time budget is too large";
   if (std::string e = tracer.validate(); !e.empty()) return e;
   if (std::string e = preview.validate(); !e.empty()) return e;
+  if (std::string e = guide.validate(); !e.empty()) return e;
   return {};
 }
 
 RenderJobResult runRenderJob(const RenderJobSettings& settings, const std::function<void(double)>& progress) {
   if (std::string e = settings.validate(); !e.empty()) throw InputError(e);
-  if (settings.mode != SamplingMode::Brdf && settings.mode != SamplingMode::Preview)
-    throw InputError(std::string("mode '") + modeName(settings.mode) + "' is not available in this build yet");
 
   RenderJobResult result;
   const auto start = Clock::now();
@@ -74,8 +75,9 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, const std::funct
   const PathTracer tracer(scene, settings.tracer);
   // VPLs (camera-independent), then slices and clusters for this camera.
   VplField field;
+  GuideField guide;
   PixelShaderFactory shader;
-  if (settings.mode == SamplingMode::Preview) {
+  if (settings.mode != SamplingMode::Brdf) {
     auto t = Clock::now();
     VplSettings vplSettings = settings.preview.vpl;
     vplSettings.seed = settings.seed;
@@ -93,7 +95,17 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, const std::funct
     size_t clusterTotal = 0;
     for (const SliceClusters& s : field.clusters.slices) clusterTotal += s.clusters.size();
     result.clustersPerSlice = field.tree.slices.empty() ? 0.0 : double(clusterTotal) / double(field.tree.slices.size());
-    shader = previewShader(scene, field, settings.preview);
+    if (settings.mode == SamplingMode::Preview) {
+      shader = previewShader(scene, field, settings.preview);
+    } else {
+      guide = buildGuideField(scene, field, settings.guide);
+      result.timings.cluster = secondsSince(t);
+      result.guideBytes = guide.memoryBytes();
+      const SamplingMode mode = settings.mode;
+      shader = pathTracerShader(tracer, [&guide, mode](uint32_t, uint64_t) {
+        return std::make_unique<GuidedContinuation>(guide, mode);
+      });
+    }
   } else {
     shader = pathTracerShader(tracer);
   }
@@ -115,6 +127,8 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, const std::funct
     result.discarded += stats.discarded;
     result.bsdfSamples += stats.bsdfSamples;
     result.guideSamples += stats.guideSamples;
+    result.proposals += stats.proposals;
+    result.accepted += stats.accepted;
     if (timed && pass > 0 && stop.load()) break;  // cut short: not a complete pass
     ++result.spp;
     if (pass == 0) result.firstImageSeconds = secondsSince(loaded);

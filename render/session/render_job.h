@@ -9,6 +9,7 @@
 #include "render/integrator/path_tracer.h"
 #include "render/integrator/sampling_mode.h"
 #include "render/scene/render_scene.h"
+#include "render/guide/guide_settings.h"
 #include "render/vpl/vpl_preview.h"
 
 namespace vpl {
@@ -22,6 +23,7 @@ struct RenderJobSettings {
   double timeBudget = 0.0;    // seconds after load (BVH, VPLs, clustering and rendering all count)
   PathTracerSettings tracer;
   PreviewSettings preview;  // VPLs, slices and clusters (preview and guided modes)
+  GuideSettings guide;      // guided modes
   SkySettings sky;
 
   std::string validate() const;  // empty when valid
@@ -41,6 +43,8 @@ struct RenderJobResult {
   size_t triangles = 0;
   size_t vplCount = 0, sliceCount = 0;
   double clustersPerSlice = 0.0;
+  uint64_t proposals = 0, accepted = 0;  // Metropolis mutations
+  size_t guideBytes = 0;
   std::vector<std::string> notices;
 };
 

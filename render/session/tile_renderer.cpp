@@ -47,6 +47,8 @@ PassStats TileRenderer::renderPass(Film& film, uint64_t pass, const std::atomic<
     stats.rays += path.rays;
     stats.bsdfSamples += path.bsdfSamples;
     stats.guideSamples += path.guideSamples;
+    stats.proposals += path.proposals;
+    stats.accepted += path.accepted;
   });
   PassStats total;
   perThread.combine_each([&](const PassStats& s) { total += s; });

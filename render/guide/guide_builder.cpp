@@ -1,0 +1,47 @@
+#include "render/guide/guide_builder.h"
+
+#include <tbb/parallel_for.h>
+#include "render/core/color.h"
+
+namespace vpl {
+
+GuideField buildGuideField(const RenderScene& scene, const VplField& field, const GuideSettings& settings) {
+  const size_t sliceCount = field.tree.slices.size();
+  std::vector<CachePoint> points(sliceCount);
+  const float minRadius = 1e-3f * scene.radius();
+  tbb::parallel_for(size_t(0), sliceCount, [&](size_t s) {
+    const Slice& slice = field.tree.slices[s];
+    const SurfaceHit& hit = field.gather.hits[slice.representative];
+    CachePoint& cp = points[s];
+    cp.position = hit.position;
+    cp.normal = hit.shadingNormal;
+    float radius = minRadius;
+    for (uint32_t i = slice.begin; i < slice.end; ++i)
+      radius = std::max(radius, glm::distance(field.gather.points[field.tree.order[i]].position, cp.position));
+    cp.radius = radius;
+
+    std::vector<GuideRepresentative> reps;
+    const auto& clusters = field.clusters.slices[s].clusters;
+    reps.reserve(clusters.size());
+    for (const VplCluster& c : clusters) {
+      const Vpl& light = field.vpls->vpls[c.representative];
+      const float repPower = light.power();
+      const glm::vec3 d = light.position - hit.position;
+      const float dist2 = glm::dot(d, d);
+      if (!(repPower > 0.0f) || !(dist2 > 0.0f)) continue;
+      const glm::vec3 dir = d / std::sqrt(dist2);
+      const float cosReceiver = glm::dot(dir, hit.shadingNormal);
+      if (cosReceiver <= 0.0f || glm::dot(dir, hit.geometricNormal) <= 0.0f) continue;
+      const Bsdf emitter(light.bsdf, Frame::fromNormal(light.normal));
+      const float leaving = luminance(emitter.eval(light.incident, -dir) * light.flux) * (c.totalPower / repPower);
+      const float weight = leaving * cosReceiver / std::max(dist2, field.minDistance * field.minDistance);
+      if (!(weight > 0.0f) || !std::isfinite(weight)) continue;
+      if (scene.accel().occluded(spawnShadowRay(hit, dir, std::sqrt(dist2)))) continue;
+      reps.push_back({dir, weight});
+    }
+    cp.distribution = GuideDistribution(std::move(reps), settings.coneAngle, settings.defensive);
+  });
+  return GuideField(std::move(points), settings);
+}
+
+}  // namespace vpl

@@ -1,0 +1,46 @@
+// All cache points of a camera view with their guide distributions, and the lookup of the cache
+// point that serves a path vertex (by position and normal). Immutable once built: render threads
+// only read it.
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <vector>
+#include <glm/glm.hpp>
+#include "render/guide/guide_distribution.h"
+#include "render/guide/guide_settings.h"
+
+namespace vpl {
+
+struct CachePoint {
+  glm::vec3 position{0.0f};
+  glm::vec3 normal{0, 0, 1};
+  float radius = 0.0f;  // lookup radius, world units
+  GuideDistribution distribution;
+};
+
+class GuideField {
+ public:
+  GuideField();
+  GuideField(std::vector<CachePoint> points, const GuideSettings& settings);
+  GuideField(GuideField&&) noexcept;
+  GuideField& operator=(GuideField&&) noexcept;
+  ~GuideField();
+
+  // Among the 8 cache points nearest p, the nearest one within its radius whose normal agrees with n; or -1.
+  int lookup(const glm::vec3& p, const glm::vec3& n) const;
+  int lookupLinear(const glm::vec3& p, const glm::vec3& n) const;  // brute force, for tests
+
+  const CachePoint& point(int i) const { return points_[size_t(i)]; }
+  size_t size() const { return points_.size(); }
+  const GuideSettings& settings() const { return settings_; }
+  size_t memoryBytes() const;
+
+ private:
+  struct Index;
+  std::vector<CachePoint> points_;
+  GuideSettings settings_;
+  float maxRadius_ = 0.0f;
+  std::unique_ptr<Index> index_;
+};
+
+}  // namespace vpl

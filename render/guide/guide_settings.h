@@ -1,0 +1,41 @@
+// Settings of the VPL guide (Hua & Low 2015; DESIGN.md §2 steps 6–8). Defaults follow the authors'
+// released code where it applies ("Starting defaults" in DESIGN.md).
+//
+//   coneAngle          float  0.1    half-angle (radians) of the cone whose mean radiance is the target
+//   defensive          float  0.01   share of the uniform sphere density mixed into the guide pdf
+//   uniformMutation    float  0.5    probability that a Metropolis mutation is an independent direction
+//   perturbationAngle  float  0.157  half-angle (radians, 9 deg) of the local perturbation
+//   mutations          int    1      Markov chain steps per requested direction
+//   bsdfProbability    float  0.5    one-sample MIS: probability of sampling the BSDF instead of the guide
+//   lookupCosNormal    float  0.9    a vertex uses a cache point only if their normals agree this well
+//   lookupRadiusScale  float  1.5    ... and it lies within this multiple of the cache point's slice radius
+#pragma once
+#include <cmath>
+#include <string>
+
+namespace vpl {
+
+struct GuideSettings {
+  float coneAngle = 0.1f;
+  float defensive = 0.01f;
+  float uniformMutation = 0.5f;
+  float perturbationAngle = 0.157f;
+  int mutations = 1;
+  float bsdfProbability = 0.5f;
+  float lookupCosNormal = 0.9f;
+  float lookupRadiusScale = 1.5f;
+
+  std::string validate() const {
+    if (!(coneAngle > 1e-4f && coneAngle <= 3.1416f)) return "guide cone angle must be in (1e-4, pi] radians";
+    if (!(defensive > 0.0f && defensive <= 1.0f)) return "defensive fraction must be in (0, 1]";
+    if (!(uniformMutation >= 0.0f && uniformMutation <= 1.0f)) return "uniform mutation probability must be in [0, 1]";
+    if (!(perturbationAngle > 0.0f && perturbationAngle <= 3.1416f)) return "perturbation angle must be in (0, pi]";
+    if (mutations < 1 || mutations > 1000) return "mutations per sample must be between 1 and 1000";
+    if (!(bsdfProbability >= 0.0f && bsdfProbability <= 1.0f)) return "BSDF selection probability must be in [0, 1]";
+    if (!(lookupCosNormal >= -1.0f && lookupCosNormal <= 1.0f)) return "lookup normal cosine must be in [-1, 1]";
+    if (!(lookupRadiusScale > 0.0f)) return "lookup radius scale must be positive";
+    return {};
+  }
+};
+
+}  // namespace vpl

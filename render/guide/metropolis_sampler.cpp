@@ -1,0 +1,34 @@
+#include "render/guide/metropolis_sampler.h"
+
+#include <cmath>
+#include "render/core/frame.h"
+#include "render/sampling/warps.h"
+
+namespace vpl {
+
+MetropolisChain::MetropolisChain(const GuideDistribution& distribution, Rng& rng)
+    : state_(distribution.sample(rng)), statePdf_(distribution.pdf(state_)) {}
+
+glm::vec3 MetropolisChain::next(const GuideDistribution& distribution, const GuideSettings& settings, Rng& rng,
+                                ChainStats& stats) {
+  const float cosPerturb = std::cos(settings.perturbationAngle);
+  for (int m = 0; m < settings.mutations; ++m) {
+    const float uKind = rng.uniform();
+    const glm::vec2 u = rng.uniform2();
+    // Both proposals are symmetric (q(x -> y) = q(y -> x)), so the acceptance is the pdf ratio.
+    const glm::vec3 proposal = uKind < settings.uniformMutation
+                                   ? sampleUniformSphere(u)
+                                   : glm::normalize(Frame::fromNormal(state_).toWorld(sampleUniformCone(u, cosPerturb)));
+    const float proposalPdf = distribution.pdf(proposal);
+    ++stats.proposals;
+    // The defensive term keeps both pdfs positive, so the ratio is always defined.
+    if (rng.uniform() * statePdf_ < proposalPdf) {
+      state_ = proposal;
+      statePdf_ = proposalPdf;
+      ++stats.accepted;
+    }
+  }
+  return state_;
+}
+
+}  // namespace vpl

@@ -1,0 +1,34 @@
+// A Markov chain over directions whose stationary density is a cache point's guide pdf (Hua & Low
+// 2015; DESIGN.md §2 step 7). Two symmetric proposals: an independent uniform direction, or a
+// uniform perturbation within a small cone around the current state; acceptance min(1, p(y)/p(x)).
+// The chain starts from an exact sample of the pdf, so every state it returns is distributed by the
+// pdf itself: dividing by pdf() keeps the path tracer unbiased.
+#pragma once
+#include <cstdint>
+#include <glm/glm.hpp>
+#include "render/guide/guide_distribution.h"
+#include "render/guide/guide_settings.h"
+
+namespace vpl {
+
+struct ChainStats {
+  uint64_t proposals = 0, accepted = 0;
+};
+
+class MetropolisChain {
+ public:
+  MetropolisChain() = default;
+  // Starts at an exact sample of the distribution.
+  MetropolisChain(const GuideDistribution& distribution, Rng& rng);
+
+  // Runs `settings.mutations` steps and returns the new state.
+  glm::vec3 next(const GuideDistribution& distribution, const GuideSettings& settings, Rng& rng, ChainStats& stats);
+
+  glm::vec3 state() const { return state_; }
+
+ private:
+  glm::vec3 state_{0, 0, 1};
+  float statePdf_ = 0.0f;
+};
+
+}  // namespace vpl

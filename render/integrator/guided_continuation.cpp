@@ -1,0 +1,60 @@
+#include "render/integrator/guided_continuation.h"
+
+namespace vpl {
+
+float GuidedContinuation::bsdfProbability() const {
+  switch (mode_) {
+    case SamplingMode::Mis: return field_.settings().bsdfProbability;
+    case SamplingMode::Metropolis:
+    case SamplingMode::Mixture: return 0.0f;
+    default: return 1.0f;
+  }
+}
+
+int GuidedContinuation::cachePoint(const SurfaceHit& hit) {
+  if (hit.position != lastPosition_ || hit.shadingNormal != lastNormal_) {
+    lastPosition_ = hit.position;
+    lastNormal_ = hit.shadingNormal;
+    lastCachePoint_ = field_.lookup(hit.position, hit.shadingNormal);
+  }
+  return lastCachePoint_;
+}
+
+bool GuidedContinuation::sample(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, Rng& rng,
+                                DirectionSample& out, PathStats& stats) {
+  const int c = cachePoint(hit);
+  const float pBsdf = c < 0 ? 1.0f : bsdfProbability();
+  const float uStrategy = rng.uniform();
+  if (uStrategy < pBsdf) {
+    const float uLobe = rng.uniform();
+    const auto s = bsdf.sample(wo, rng.uniform2(), uLobe);
+    if (!s) return false;
+    out.wi = s->wi;
+    ++stats.bsdfSamples;
+  } else {
+    const GuideDistribution& guide = field_.point(c).distribution;
+    if (mode_ == SamplingMode::Mixture) {
+      out.wi = guide.sample(rng);
+    } else {
+      auto it = chains_.find(c);
+      if (it == chains_.end()) it = chains_.emplace(c, MetropolisChain(guide, rng)).first;
+      ChainStats chain;
+      out.wi = it->second.next(guide, field_.settings(), rng, chain);
+      stats.proposals += chain.proposals;
+      stats.accepted += chain.accepted;
+    }
+    ++stats.guideSamples;
+  }
+  out.pdf = pdf(hit, bsdf, wo, out.wi);
+  return out.pdf > 0.0f;
+}
+
+float GuidedContinuation::pdf(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, const glm::vec3& wi) {
+  const int c = cachePoint(hit);
+  if (c < 0) return bsdf.pdf(wo, wi);
+  const float pBsdf = bsdfProbability();
+  const float guidePdf = field_.point(c).distribution.pdf(wi);
+  return pBsdf > 0.0f ? pBsdf * bsdf.pdf(wo, wi) + (1.0f - pBsdf) * guidePdf : guidePdf;
+}
+
+}  // namespace vpl

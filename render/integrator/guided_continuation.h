@@ -1,0 +1,37 @@
+// Continuation directions from the VPL guide (DESIGN.md §2 step 8):
+//   metropolis  the cache point's Markov chain alone
+//   mixture     exact samples of the same target (representative by weight, then its cone)
+//   mis         one-sample MIS of the BSDF and the Markov chain, balance heuristic with both pdfs
+// A vertex with no cache point nearby (distance or normal test) samples its BSDF. One object per
+// tile and pass: its chains restart from exact samples, so results do not depend on scheduling.
+#pragma once
+#include <unordered_map>
+#include "render/guide/guide_field.h"
+#include "render/guide/metropolis_sampler.h"
+#include "render/integrator/path_tracer.h"
+#include "render/integrator/sampling_mode.h"
+
+namespace vpl {
+
+class GuidedContinuation final : public ContinuationSampler {
+ public:
+  GuidedContinuation(const GuideField& field, SamplingMode mode) : field_(field), mode_(mode) {}
+
+  bool sample(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, Rng& rng, DirectionSample& out,
+              PathStats& stats) override;
+  float pdf(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, const glm::vec3& wi) override;
+
+ private:
+  // Probability of drawing from the BSDF at a vertex served by a cache point.
+  float bsdfProbability() const;
+  // The cache point of a vertex; sample() and pdf() ask for the same vertex in a row, so remember it.
+  int cachePoint(const SurfaceHit& hit);
+
+  const GuideField& field_;
+  SamplingMode mode_;
+  std::unordered_map<int, MetropolisChain> chains_;
+  glm::vec3 lastPosition_{NAN}, lastNormal_{NAN};
+  int lastCachePoint_ = -1;
+};
+
+}  // namespace vpl
