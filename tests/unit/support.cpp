@@ -66,7 +66,7 @@ double integrateSphere(const std::function<double(const glm::vec3&)>& f, int cos
 
 ChiSquareResult chiSquareSphere(const std::function<glm::vec3()>& sample,
                                 const std::function<double(const glm::vec3&)>& pdf, int sampleCount,
-                                int cosThetaBins, int phiBins, int subdivisions) {
+                                int cosThetaBins, int phiBins, int subdivisions, bool renormalise) {
   const int binCount = cosThetaBins * phiBins;
   std::vector<double> observed(binCount + 1, 0.0), expected(binCount + 1, 0.0);  // last = "no sample"
 
@@ -99,6 +99,10 @@ ChiSquareResult chiSquareSphere(const std::function<glm::vec3()>& sample,
       expected[i * phiBins + j] = integral * sampleCount;
       total += integral;
     }
+  if (renormalise && total > 0.0) {
+    for (int k = 0; k < binCount; ++k) expected[k] /= total;
+    total = 1.0;
+  }
   expected[binCount] = std::max(0.0, 1.0 - total) * sampleCount;
 
   // Pool the low-expectation bins (in increasing order of expectation) as Nori and pbrt do.

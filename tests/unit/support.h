@@ -22,7 +22,10 @@ struct ChiSquareResult {
 // compared with 1 - integral(pdf).
 ChiSquareResult chiSquareSphere(const std::function<glm::vec3()>& sample,
                                 const std::function<double(const glm::vec3&)>& pdf, int sampleCount,
-                                int cosThetaBins = 32, int phiBins = 64, int subdivisions = 8);
+                                int cosThetaBins = 32, int phiBins = 64, int subdivisions = 8,
+                                bool renormalise = false);
+// renormalise: the sampler never fails and its pdf's integral is tested elsewhere, so scale the
+// expected counts to sum to the sample count (removes quadrature error of very peaked pdfs).
 
 // Integral of f over the unit sphere by a fine (cos theta, phi) midpoint grid.
 double integrateSphere(const std::function<double(const glm::vec3&)>& f, int cosThetaSteps = 512,

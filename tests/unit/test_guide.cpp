@@ -1,0 +1,180 @@
+// The guide distribution, its Metropolis chain and the cache-point lookup, against their definitions.
+#include <cmath>
+#include <numbers>
+#include "render/guide/guide_distribution.h"
+#include "render/guide/guide_field.h"
+#include "render/guide/metropolis_sampler.h"
+#include "render/sampling/warps.h"
+#include "tests/unit/support.h"
+
+namespace vpl {
+namespace {
+
+constexpr float kDeg = std::numbers::pi_v<float> / 180.0f;
+
+std::vector<GuideRepresentative> randomReps(size_t n, uint64_t seed, bool clustered = false) {
+  Rng rng(seed);
+  std::vector<GuideRepresentative> reps(n);
+  const glm::vec3 axis = glm::normalize(glm::vec3(0.3f, 0.8f, 0.2f));
+  for (auto& r : reps) {
+    r.direction = clustered ? glm::normalize(axis + 0.3f * sampleUniformSphere(rng.uniform2())) : sampleUniformSphere(rng.uniform2());
+    r.weight = 0.1f + 2.0f * rng.uniform();
+  }
+  return reps;
+}
+
+struct Case {
+  const char* name;
+  size_t reps;
+  float coneDegrees;
+  bool clustered;
+};
+
+std::vector<Case> cases() {
+  return {{"one wide", 1, 30, false},  {"one narrow", 1, 3, false},    {"few wide", 5, 30, true},
+          {"few narrow", 5, 3, true},  {"many wide", 500, 30, false},  {"many narrow", 500, 3, true}};
+}
+
+TEST(GuideDistribution, PdfIntegratesToOneAndMatchesTheTarget) {
+  for (const Case& c : cases()) {
+    const GuideDistribution d(randomReps(c.reps, 1, c.clustered), c.coneDegrees * kDeg, 0.01f);
+    const double integral = test::integrateSphere([&](const glm::vec3& w) { return double(d.pdf(w)); }, 1024, 2048);
+    EXPECT_NEAR(integral, 1.0, c.coneDegrees < 10 ? 0.03 : 0.005) << c.name;
+    Rng rng(2);
+    for (int i = 0; i < 200; ++i) {
+      const glm::vec3 w = sampleUniformSphere(rng.uniform2());
+      const double expected = 0.99 * d.target(w) / d.totalWeight() + 0.01 / (4.0 * std::numbers::pi);
+      ASSERT_NEAR(d.pdf(w), expected, 1e-5 * expected) << c.name;
+    }
+  }
+}
+
+TEST(GuideDistribution, TargetIntegratesToTotalWeight) {
+  const GuideDistribution d(randomReps(20, 3, true), 20.0f * kDeg, 0.01f);
+  const double integral = test::integrateSphere([&](const glm::vec3& w) { return double(d.target(w)); }, 1024, 2048);
+  EXPECT_NEAR(integral, d.totalWeight(), 0.005 * d.totalWeight());
+}
+
+TEST(GuideDistribution, KdTreeConeQueryEqualsLinearScan) {
+  for (const Case& c : cases()) {
+    const GuideDistribution d(randomReps(c.reps, 4, c.clustered), c.coneDegrees * kDeg, 0.01f);
+    Rng rng(5);
+    for (int i = 0; i < 2000; ++i) {
+      // Half the queries right at representatives, where cones overlap the most.
+      const glm::vec3 w = (i % 2 == 0 && d.size() > 0) ? d.representatives()[i % d.size()].direction
+                                                       : sampleUniformSphere(rng.uniform2());
+      ASSERT_NEAR(d.coneSum(w), d.coneSumLinear(w), 1e-9 + 1e-6 * d.coneSumLinear(w)) << c.name;
+    }
+  }
+}
+
+TEST(GuideDistribution, ZeroWeightIsUniform) {
+  std::vector<GuideRepresentative> reps = {{glm::vec3(0, 0, 1), 0.0f}, {glm::vec3(1, 0, 0), -1.0f}};
+  const GuideDistribution d(reps, 0.1f, 0.01f);
+  EXPECT_FLOAT_EQ(d.pdf(glm::vec3(0, 0, 1)), uniformSpherePdf());
+  const GuideDistribution empty({}, 0.1f, 0.01f);
+  Rng rng(1);
+  EXPECT_NEAR(glm::length(empty.sample(rng)), 1.0f, 1e-5f);
+}
+
+TEST(GuideDistribution, ExactSamplerMatchesPdf) {
+  for (const Case& c : cases()) {
+    const GuideDistribution d(randomReps(c.reps, 6, c.clustered), c.coneDegrees * kDeg, 0.01f);
+    Rng rng(7);
+    const int bins = c.coneDegrees < 10 ? 96 : 32;
+    const auto r = test::chiSquareSphere([&] { return d.sample(rng); }, [&](const glm::vec3& w) { return double(d.pdf(w)); },
+                                         200000, bins, 2 * bins, c.coneDegrees < 10 ? 16 : 8, true);
+    EXPECT_GT(r.pValue, 1e-4) << c.name << ": " << r.report;
+  }
+}
+
+TEST(Metropolis, IndependentChainsAreDistributedByThePdf) {
+  // Chains started exactly and run K mutations: their final states are independent draws of the
+  // stationary density, which must be the pdf.
+  GuideSettings settings;
+  for (const Case& c : cases()) {
+    const GuideDistribution d(randomReps(c.reps, 8, c.clustered), c.coneDegrees * kDeg, 0.01f);
+    Rng rng(9);
+    ChainStats stats;
+    auto sample = [&] {
+      MetropolisChain chain(d, rng);
+      glm::vec3 w;
+      for (int k = 0; k < 5; ++k) w = chain.next(d, settings, rng, stats);
+      return w;
+    };
+    const int bins = c.coneDegrees < 10 ? 96 : 32;
+    const auto r = test::chiSquareSphere(sample, [&](const glm::vec3& w) { return double(d.pdf(w)); }, 100000, bins,
+                                         2 * bins, c.coneDegrees < 10 ? 16 : 8, true);
+    EXPECT_GT(r.pValue, 1e-4) << c.name << ": " << r.report;
+    const double acceptance = double(stats.accepted) / double(stats.proposals);
+    EXPECT_GT(acceptance, 0.005) << c.name;
+    EXPECT_LT(acceptance, 1.0) << c.name;
+    std::printf("%-12s acceptance %.3f\n", c.name, acceptance);
+  }
+}
+
+TEST(Metropolis, LongChainVisitsBinsInProportion) {
+  // One long chain (correlated states): bin frequencies against pdf mass, with batch-means errors.
+  const GuideDistribution d(randomReps(5, 10, true), 30.0f * kDeg, 0.01f);
+  GuideSettings settings;
+  Rng rng(11);
+  MetropolisChain chain(d, rng);
+  ChainStats stats;
+  // Four bins: the hemisphere around the representatives' axis split by cos theta.
+  const glm::vec3 axis = glm::normalize(glm::vec3(0.3f, 0.8f, 0.2f));
+  auto bin = [&](const glm::vec3& w) { return std::clamp(int((glm::dot(w, axis) + 1.0f) * 2.0f), 0, 3); };
+  double mass[4] = {};
+  const double total = test::integrateSphere([&](const glm::vec3& w) { return double(d.pdf(w)); }, 512, 1024);
+  for (int b = 0; b < 4; ++b)
+    mass[b] = test::integrateSphere([&](const glm::vec3& w) { return bin(w) == b ? double(d.pdf(w)) : 0.0; }, 512, 1024) / total;
+  const int batches = 50, perBatch = 20000;
+  std::vector<std::array<double, 4>> freq(batches);
+  for (int b = 0; b < batches; ++b) {
+    std::array<double, 4> f{};
+    for (int i = 0; i < perBatch; ++i) f[size_t(bin(chain.next(d, settings, rng, stats)))] += 1.0 / perBatch;
+    freq[size_t(b)] = f;
+  }
+  for (int k = 0; k < 4; ++k) {
+    double mean = 0, var = 0;
+    for (const auto& f : freq) mean += f[size_t(k)] / batches;
+    for (const auto& f : freq) var += (f[size_t(k)] - mean) * (f[size_t(k)] - mean) / (batches - 1);
+    EXPECT_NEAR(mean, mass[k], 5.0 * std::sqrt(var / batches) + 1e-4) << "bin " << k;
+  }
+}
+
+TEST(Metropolis, SameSeedSameChain) {
+  const GuideDistribution d(randomReps(50, 12), 10.0f * kDeg, 0.01f);
+  GuideSettings settings;
+  Rng a(3), b(3);
+  MetropolisChain ca(d, a), cb(d, b);
+  ChainStats s;
+  for (int i = 0; i < 100; ++i) ASSERT_EQ(ca.next(d, settings, a, s), cb.next(d, settings, b, s));
+}
+
+TEST(GuideField, LookupEqualsBruteForce) {
+  Rng rng(13);
+  std::vector<CachePoint> points(300);
+  for (auto& p : points) {
+    p.position = glm::vec3(rng.uniform(), rng.uniform(), rng.uniform()) * 10.0f;
+    p.normal = sampleUniformSphere(rng.uniform2());
+    p.radius = 0.2f + rng.uniform();
+  }
+  GuideSettings settings;
+  const GuideField field(std::move(points), settings);
+  int hits = 0;
+  for (int i = 0; i < 5000; ++i) {
+    const glm::vec3 p = glm::vec3(rng.uniform(), rng.uniform(), rng.uniform()) * 10.0f;
+    const glm::vec3 n = i % 2 ? field.point(int(i % field.size())).normal : sampleUniformSphere(rng.uniform2());
+    const int got = field.lookup(p, n);
+    ASSERT_EQ(got, field.lookupLinear(p, n)) << i;
+    hits += got >= 0;
+  }
+  EXPECT_GT(hits, 100);
+  // Far away, or facing the other way: no cache point.
+  EXPECT_EQ(field.lookup(glm::vec3(100.0f), glm::vec3(0, 0, 1)), -1);
+  EXPECT_EQ(field.lookup(field.point(0).position, -field.point(0).normal), -1);
+  EXPECT_EQ(GuideField().lookup(glm::vec3(0.0f), glm::vec3(0, 0, 1)), -1);
+}
+
+}  // namespace
+}  // namespace vpl
