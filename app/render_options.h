@@ -21,7 +21,7 @@ struct RenderOptions {
   double rawSeconds = 3.0;  // bench only
   PreviewSettings preview;  // VPL, slice and cluster flags
   GuideSettings guide;
-  float coneDegrees = 5.73f, perturbDegrees = 9.0f;
+  float coneDegrees = 20.4f, perturbDegrees = 9.0f;
 
   void addTo(CLI::App& command, bool requireOut);
   // Checked conversion; throws InputError for values CLI11 cannot check alone.

@@ -1,8 +1,9 @@
 // Settings of the VPL guide (Hua & Low 2015; DESIGN.md §2 steps 6–8). Defaults follow the authors'
 // released code where it applies ("Starting defaults" in DESIGN.md).
 //
-//   coneAngle          float  0.1    half-angle (radians) of the cone whose mean radiance is the target
-//   defensive          float  0.01   share of the uniform sphere density mixed into the guide pdf
+//   coneAngle          float  0.356  half-angle (radians, 20.4 deg: the authors' radius 0.1 on an equal-area map)
+//   defensive          float  0.1    share of the uniform sphere density mixed into the guide pdf (measured: 0.01
+//                                    leaves heavy tails in the guide-only modes)
 //   uniformMutation    float  0.5    probability that a Metropolis mutation is an independent direction
 //   perturbationAngle  float  0.157  half-angle (radians, 9 deg) of the local perturbation
 //   mutations          int    1      Markov chain steps per requested direction
@@ -16,8 +17,8 @@
 namespace vpl {
 
 struct GuideSettings {
-  float coneAngle = 0.1f;
-  float defensive = 0.01f;
+  float coneAngle = 0.356f;
+  float defensive = 0.1f;
   float uniformMutation = 0.5f;
   float perturbationAngle = 0.157f;
   int mutations = 1;

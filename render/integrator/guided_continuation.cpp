@@ -1,5 +1,7 @@
 #include "render/integrator/guided_continuation.h"
 
+#include <algorithm>
+
 namespace vpl {
 
 float GuidedContinuation::bsdfProbability() const {
@@ -33,9 +35,11 @@ bool GuidedContinuation::sample(const SurfaceHit& hit, const Bsdf& bsdf, const g
     ++stats.bsdfSamples;
   } else {
     const GuideDistribution& guide = field_.point(c).distribution;
-    if (mode_ == SamplingMode::Mixture) {
+    const bool revisit = std::find(chainsUsedByPath_.begin(), chainsUsedByPath_.end(), c) != chainsUsedByPath_.end();
+    if (mode_ == SamplingMode::Mixture || revisit) {
       out.wi = guide.sample(rng);
     } else {
+      chainsUsedByPath_.push_back(c);
       auto it = chains_.find(c);
       if (it == chains_.end()) it = chains_.emplace(c, MetropolisChain(guide, rng)).first;
       ChainStats chain;

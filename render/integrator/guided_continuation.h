@@ -20,6 +20,7 @@ class GuidedContinuation final : public ContinuationSampler {
   bool sample(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, Rng& rng, DirectionSample& out,
               PathStats& stats) override;
   float pdf(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, const glm::vec3& wi) override;
+  void beginPath() override { chainsUsedByPath_.clear(); }
 
  private:
   // Probability of drawing from the BSDF at a vertex served by a cache point.
@@ -30,6 +31,10 @@ class GuidedContinuation final : public ContinuationSampler {
   const GuideField& field_;
   SamplingMode mode_;
   std::unordered_map<int, MetropolisChain> chains_;
+  // A path must not draw twice from one chain: the second state would depend on the first, and path
+  // tracing needs each direction to have the sampling density given the path so far. A revisit
+  // draws an exact sample of the same density instead.
+  std::vector<int> chainsUsedByPath_;
   glm::vec3 lastPosition_{NAN}, lastNormal_{NAN};
   int lastCachePoint_ = -1;
 };

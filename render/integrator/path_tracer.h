@@ -39,6 +39,8 @@ struct DirectionSample {
 class ContinuationSampler {
  public:
   virtual ~ContinuationSampler() = default;
+  // Called at the start of every camera path.
+  virtual void beginPath() {}
   // Picks a direction at this vertex; returns false when the path should end.
   virtual bool sample(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, Rng& rng,
                       DirectionSample& out, PathStats& stats) = 0;
