@@ -23,5 +23,12 @@ if [ ${#missing[@]} -gt 0 ]; then
   apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
 
+# The Khronos glTF validator for the scene tests (optional: the test skips without it).
+if command -v npm >/dev/null && [ ! -d "$build/tools/node_modules/gltf-validator" ]; then
+  mkdir -p "$build/tools"
+  npm install --silent --no-audit --no-fund --prefix "$build/tools" gltf-validator@2.0.0-dev.3.10 >/dev/null 2>&1 ||
+    echo "setup: warning: could not install gltf-validator from npm; its test will be skipped" >&2
+fi
+
 cmake -S "$here" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE="${VPLVIEW_BUILD_TYPE:-Release}" ${VPLVIEW_CMAKE_ARGS:-} >/dev/null
 cmake --build "$build" --parallel "$(nproc)"
