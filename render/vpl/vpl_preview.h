@@ -5,7 +5,7 @@
 // sharper with every pass.
 //
 // Parameters (PreviewSettings):
-//   vpl.count            int    32768  VPLs (see VplSettings)
+//   vpl.count            int    16384  VPLs (see VplSettings)
 //   slices.*                            see SliceSettings
 //   clustering.*                        see LightSliceSettings
 //   clampFraction        float  0.01   geometry-term clamp: 1/d^2 <= 1/(clampFraction x scene diagonal)^2
