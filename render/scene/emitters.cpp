@@ -79,6 +79,13 @@ EmitterSet::EmitterSet(const SceneData& scene, const glm::vec3& sky, const glm::
   distribution_ = Distribution1D(power);
 }
 
+EmitterSet::TrianglePoint EmitterSet::trianglePoint(const TriangleLight& light, glm::vec2 b) const {
+  const MeshData& mesh = scene_->meshes[light.mesh];
+  const uint32_t* idx = &mesh.indices[3 * size_t(light.triangle)];
+  const glm::vec3 p0 = mesh.positions[idx[0]], p1 = mesh.positions[idx[1]], p2 = mesh.positions[idx[2]];
+  return {p0 * (1.0f - b.x - b.y) + p1 * b.x + p2 * b.y, glm::normalize(glm::cross(p1 - p0, p2 - p0))};
+}
+
 glm::vec3 EmitterSet::triangleRadiance(const TriangleLight& light, glm::vec2 b, bool frontSide) const {
   if (!frontSide && !light.twoSided) return glm::vec3(0.0f);
   const MeshData& mesh = scene_->meshes[light.mesh];
@@ -103,12 +110,9 @@ std::optional<LightSample> EmitterSet::sample(const glm::vec3& p, float uLight, 
   if (index < triangles_.size()) {
     // Sample an emissive triangle by area, convert the density to solid angle at p.
     const TriangleLight& light = triangles_[index];
-    const MeshData& mesh = scene_->meshes[light.mesh];
-    const uint32_t* idx = &mesh.indices[3 * size_t(light.triangle)];
-    const glm::vec3 p0 = mesh.positions[idx[0]], p1 = mesh.positions[idx[1]], p2 = mesh.positions[idx[2]];
     const glm::vec2 b = sampleUniformTriangle(u);
-    const glm::vec3 x = p0 * (1.0f - b.x - b.y) + p1 * b.x + p2 * b.y;
-    const glm::vec3 n = glm::normalize(glm::cross(p1 - p0, p2 - p0));
+    const TrianglePoint tp = trianglePoint(light, b);
+    const glm::vec3 x = tp.position, n = tp.normal;
     const glm::vec3 d = x - p;
     const float dist2 = glm::dot(d, d);
     if (!(dist2 > 0.0f)) return std::nullopt;
@@ -184,11 +188,9 @@ std::optional<EmissionSample> EmitterSet::sampleEmission(float uLight, glm::vec2
   if (index < triangles_.size()) {
     // Position uniform on the triangle, direction cosine-distributed: weight = Le pi area / pmf.
     const TriangleLight& light = triangles_[index];
-    const MeshData& mesh = scene_->meshes[light.mesh];
-    const uint32_t* idx = &mesh.indices[3 * size_t(light.triangle)];
-    const glm::vec3 p0 = mesh.positions[idx[0]], p1 = mesh.positions[idx[1]], p2 = mesh.positions[idx[2]];
     const glm::vec2 b = sampleUniformTriangle(uPos);
-    glm::vec3 n = glm::normalize(glm::cross(p1 - p0, p2 - p0));
+    const TrianglePoint tp = trianglePoint(light, b);
+    glm::vec3 n = tp.normal;
     bool front = true;
     float sides = 1.0f;
     if (light.twoSided) {
@@ -196,7 +198,7 @@ std::optional<EmissionSample> EmitterSet::sampleEmission(float uLight, glm::vec2
       sides = 2.0f;
     }
     if (!front) n = -n;
-    e.position = p0 * (1.0f - b.x - b.y) + p1 * b.x + p2 * b.y;
+    e.position = tp.position;
     e.normal = n;
     e.direction = Frame::fromNormal(n).toWorld(sampleCosineHemisphere(uDir));
     e.weight = triangleRadiance(light, b, front) * (kPi * light.area * sides / pmf);

@@ -69,6 +69,10 @@ class EmitterSet {
   float radius_ = 1.0f;
 
   glm::vec3 triangleRadiance(const TriangleLight& light, glm::vec2 barycentric, bool frontSide) const;
+  struct TrianglePoint {
+    glm::vec3 position, normal;  // normal from the winding (the front side)
+  };
+  TrianglePoint trianglePoint(const TriangleLight& light, glm::vec2 barycentric) const;
 };
 
 }  // namespace vpl
