@@ -41,7 +41,12 @@ GuideField buildGuideField(const RenderScene& scene, const VplField& field, cons
     }
     cp.distribution = GuideDistribution(std::move(reps), settings.coneAngle, settings.defensive);
   });
-  return GuideField(std::move(points), settings);
+  GuideField guide(std::move(points), settings);
+  std::vector<int32_t> perPixel(field.gather.pixelGather.size(), -1);
+  for (size_t px = 0; px < perPixel.size(); ++px)
+    if (field.gather.pixelGather[px] >= 0) perPixel[px] = int32_t(field.tree.sliceOf[size_t(field.gather.pixelGather[px])]);
+  guide.setPixelCachePoints(std::move(perPixel));
+  return guide;
 }
 
 }  // namespace vpl

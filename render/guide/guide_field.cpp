@@ -30,6 +30,7 @@ GuideField& GuideField::operator=(GuideField&& o) noexcept {
   settings_ = o.settings_;
   maxRadius_ = o.maxRadius_;
   index_ = std::move(o.index_);
+  pixelCachePoints_ = std::move(o.pixelCachePoints_);
   if (index_) index_->points.points = &points_;  // the adaptor refers to the vector object itself
   return *this;
 }
@@ -56,6 +57,14 @@ int GuideField::lookup(const glm::vec3& p, const glm::vec3& n) const {
     if (dist2[k] <= r * r && glm::dot(c.normal, n) >= settings_.lookupCosNormal) return int(index[k]);
   }
   return -1;
+}
+
+int GuideField::pixelCachePoint(uint64_t pixel, const glm::vec3& p, const glm::vec3& n) const {
+  if (pixel >= pixelCachePoints_.size() || pixelCachePoints_[pixel] < 0) return -1;
+  const CachePoint& c = points_[size_t(pixelCachePoints_[pixel])];
+  const glm::vec3 d = c.position - p;
+  const float r = c.radius * settings_.lookupRadiusScale;
+  return glm::dot(d, d) <= r * r && glm::dot(c.normal, n) >= settings_.lookupCosNormal ? pixelCachePoints_[pixel] : -1;
 }
 
 int GuideField::lookupLinear(const glm::vec3& p, const glm::vec3& n) const {

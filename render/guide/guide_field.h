@@ -29,6 +29,9 @@ class GuideField {
   // Among the 8 cache points nearest p, the nearest one within its radius whose normal agrees with n; or -1.
   int lookup(const glm::vec3& p, const glm::vec3& n) const;
   int lookupLinear(const glm::vec3& p, const glm::vec3& n) const;  // brute force, for tests
+  // The cache point of a pixel's slice if it passes the same radius and normal tests at (p, n), else -1.
+  int pixelCachePoint(uint64_t pixel, const glm::vec3& p, const glm::vec3& n) const;
+  void setPixelCachePoints(std::vector<int32_t> perPixel) { pixelCachePoints_ = std::move(perPixel); }
 
   const CachePoint& point(int i) const { return points_[size_t(i)]; }
   size_t size() const { return points_.size(); }
@@ -40,6 +43,7 @@ class GuideField {
   std::vector<CachePoint> points_;
   GuideSettings settings_;
   float maxRadius_ = 0.0f;
+  std::vector<int32_t> pixelCachePoints_;
   std::unique_ptr<Index> index_;
 };
 

@@ -20,7 +20,11 @@ class GuidedContinuation final : public ContinuationSampler {
   bool sample(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, Rng& rng, DirectionSample& out,
               PathStats& stats) override;
   float pdf(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, const glm::vec3& wi) override;
-  void beginPath() override { chainsUsedByPath_.clear(); }
+  void beginPath(uint64_t pixel) override {
+    chainsUsedByPath_.clear();
+    pixel_ = pixel;
+    primaryVertex_ = true;
+  }
 
  private:
   // Probability of drawing from the BSDF at a vertex served by a cache point.
@@ -37,6 +41,8 @@ class GuidedContinuation final : public ContinuationSampler {
   std::vector<int> chainsUsedByPath_;
   glm::vec3 lastPosition_{NAN}, lastNormal_{NAN};
   int lastCachePoint_ = -1;
+  uint64_t pixel_ = 0;
+  bool primaryVertex_ = false;  // the next new vertex is the camera ray's hit
 };
 
 }  // namespace vpl

@@ -28,9 +28,9 @@ float BsdfContinuation::pdf(const SurfaceHit&, const Bsdf& bsdf, const glm::vec3
 }
 
 glm::vec3 PathTracer::radiance(const Ray& cameraRay, Rng& rng, ContinuationSampler& continuation,
-                               PathStats& stats) const {
+                               PathStats& stats, uint64_t pixel) const {
   const EmitterSet& emitters = scene_.emitters();
-  continuation.beginPath();
+  continuation.beginPath(pixel);
   glm::vec3 L(0.0f), beta(1.0f);
   Ray ray = cameraRay;
   SurfaceHit previous;

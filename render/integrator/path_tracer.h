@@ -39,8 +39,8 @@ struct DirectionSample {
 class ContinuationSampler {
  public:
   virtual ~ContinuationSampler() = default;
-  // Called at the start of every camera path.
-  virtual void beginPath() {}
+  // Called at the start of every camera path, with its pixel (row-major index).
+  virtual void beginPath(uint64_t /*pixel*/) {}
   // Picks a direction at this vertex; returns false when the path should end.
   virtual bool sample(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, Rng& rng,
                       DirectionSample& out, PathStats& stats) = 0;
@@ -61,7 +61,8 @@ class PathTracer {
   PathTracer(const RenderScene& scene, const PathTracerSettings& settings) : scene_(scene), settings_(settings) {}
 
   // Radiance arriving along the camera ray. May be non-finite only through a bug; callers check.
-  glm::vec3 radiance(const Ray& cameraRay, Rng& rng, ContinuationSampler& continuation, PathStats& stats) const;
+  glm::vec3 radiance(const Ray& cameraRay, Rng& rng, ContinuationSampler& continuation, PathStats& stats,
+                     uint64_t pixel = 0) const;
 
   const PathTracerSettings& settings() const { return settings_; }
 

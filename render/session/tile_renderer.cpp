@@ -10,8 +10,8 @@ PixelShaderFactory pathTracerShader(const PathTracer& tracer, ContinuationFactor
   if (!continuation) continuation = [](uint32_t, uint64_t) { return std::make_unique<BsdfContinuation>(); };
   return [&tracer, continuation](uint32_t tile, uint64_t pass) -> PixelShader {
     std::shared_ptr<ContinuationSampler> strategy = continuation(tile, pass);
-    return [&tracer, strategy](const Ray& ray, uint64_t, Rng& rng, PathStats& stats) {
-      return tracer.radiance(ray, rng, *strategy, stats);
+    return [&tracer, strategy](const Ray& ray, uint64_t pixel, Rng& rng, PathStats& stats) {
+      return tracer.radiance(ray, rng, *strategy, stats, pixel);
     };
   };
 }
