@@ -46,7 +46,7 @@ int GuideField::lookup(const glm::vec3& p, const glm::vec3& n) const {
   if (!index_) return -1;
   // The few nearest cache points by position, then the radius and normal tests: a bounded search,
   // where a radius search would visit every point within the largest slice's radius.
-  constexpr size_t kCandidates = 8;
+  constexpr size_t kCandidates = kLookupCandidates;
   uint32_t index[kCandidates];
   float dist2[kCandidates];
   const float query[3] = {p.x, p.y, p.z};
@@ -68,14 +68,14 @@ int GuideField::pixelCachePoint(uint64_t pixel, const glm::vec3& p, const glm::v
 }
 
 int GuideField::lookupLinear(const glm::vec3& p, const glm::vec3& n) const {
-  // The same rule by brute force: among the 8 nearest cache points, the nearest that passes.
+  // The same rule by brute force.
   std::vector<std::pair<float, size_t>> byDistance;
   for (size_t i = 0; i < points_.size(); ++i) {
     const glm::vec3 d = points_[i].position - p;
     byDistance.push_back({glm::dot(d, d), i});
   }
   std::sort(byDistance.begin(), byDistance.end());
-  byDistance.resize(std::min<size_t>(8, byDistance.size()));
+  byDistance.resize(std::min<size_t>(kLookupCandidates, byDistance.size()));
   int best = -1;
   float bestDist2 = INFINITY;
   for (const auto& [unused, i] : byDistance) {
