@@ -21,7 +21,7 @@ RenderOptions gRender, gBench;
 CLI::App* gRenderCommand = nullptr;
 CLI::App* gBenchCommand = nullptr;
 CLI::App* gCompareCommand = nullptr;
-std::string gCompareImage, gCompareReference;
+std::string gCompareImage, gCompareReference, gCompareMap;
 
 nlohmann::ordered_json summaryJson(const RenderJobSettings& s, const RenderJobResult& r) {
   nlohmann::ordered_json j;
@@ -96,6 +96,11 @@ int runCompare() {
   j["reference"] = gCompareReference;
   j["relmse"] = relMse(image, reference);
   j["bias"] = relativeBias(image, reference);
+  if (!gCompareMap.empty()) {
+    checkWritable(gCompareMap);
+    writePng(gCompareMap, falseColourLog(relMseMap(image, reference)));
+    j["error_map"] = gCompareMap;
+  }
   std::printf("%s\n", j.dump().c_str());
   return 0;
 }
@@ -114,6 +119,8 @@ void registerCommands(CLI::App& app) {
   gCompareCommand = app.add_subcommand("compare", "relMSE and relative bias of an EXR image against a reference EXR");
   gCompareCommand->add_option("image", gCompareImage, "image (OpenEXR)")->required();
   gCompareCommand->add_option("reference", gCompareReference, "reference (OpenEXR)")->required();
+  gCompareCommand->add_option("--error-map", gCompareMap,
+                              "PNG of the per-pixel relMSE, log scale: black 1e-4, blue, red, yellow, white >= 1");
 }
 
 int runSelectedCommand(CLI::App& app) {

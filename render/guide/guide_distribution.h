@@ -1,14 +1,14 @@
 // The directional distribution of one cache point (Hua & Low 2015): representatives are the
 // directions to its VPL clusters with weights (their estimated contribution, W/sr-like luminance).
-// The target f(w) is the summed weight of the representatives within a cone of half-angle thetaC
-// around w, divided by the cone's solid angle: the mean incoming radiance in that cone. Its sphere
-// integral is exactly Z = sum of weights, so the sampling density is known in closed form:
-//   pdf(w) = (1 - eps) f(w) / Z + eps / (4 pi)        (uniform when Z = 0).
-// Exact sampling: a representative by weight, then a uniform direction in its cone.
+// Each representative spreads its weight evenly over the cells of an equal-area map of the sphere
+// (render/sampling/equal_area_map.h) whose centres lie within a cone of half-angle thetaC around it,
+// or over its own cell when the cone holds no centre. The target f(w) is the tabulated density of
+// w's cell: the mean incoming radiance predicted around w, as the authors' lookup radius on an
+// equal-area square. Its sphere integral is exactly Z = sum of weights, and
+//   pdf(w) = (1 - eps) f(w) / Z + eps / (4 pi)        (uniform when Z = 0)
+// costs one table read; sampling picks a cell by its mass, then a uniform point in it.
 #pragma once
 #include <cstdint>
-#include <memory>
-#include <span>
 #include <vector>
 #include <glm/glm.hpp>
 #include "render/sampling/distribution_1d.h"
@@ -23,40 +23,40 @@ struct GuideRepresentative {
 
 class GuideDistribution {
  public:
-  // Below this many representatives the cone query scans linearly (faster than the kd-tree there).
-  static constexpr size_t kLinearScanLimit = 48;
+  // Cells per side of the equal-area map: 1024 cells of 0.0123 sr (about 6 degrees across), fine
+  // against the default 20-degree cone and 12 KiB per cache point.
+  static constexpr int kResolution = 32;
+  static constexpr int kCells = kResolution * kResolution;
+  static constexpr double kCellSolidAngle = 4.0 * 3.14159265358979323846 / kCells;
 
-  GuideDistribution();
-  GuideDistribution(std::vector<GuideRepresentative> representatives, float coneAngle, float defensive);
-  GuideDistribution(GuideDistribution&&) noexcept;
-  GuideDistribution& operator=(GuideDistribution&&) noexcept;
-  ~GuideDistribution();
+  GuideDistribution() = default;
+  GuideDistribution(const std::vector<GuideRepresentative>& representatives, float coneAngle, float defensive);
 
-  // f(w): mean weight per steradian in the cone around w.
-  float target(const glm::vec3& w) const;
+  // f(w): weight per steradian of w's cell.
+  float target(const glm::vec3& w) const { return float(choice_.pmf(size_t(cellOf(w))) * total_ / kCellSolidAngle); }
   // Density of sample() per solid angle (includes the defensive term).
   float pdf(const glm::vec3& w) const;
   glm::vec3 sample(Rng& rng) const;
 
   double totalWeight() const { return total_; }
-  size_t size() const { return reps_.size(); }
-  float cosCone() const { return cosCone_; }
+  size_t size() const { return representativeCount_; }
   float defensive() const { return defensive_; }
-  const std::vector<GuideRepresentative>& representatives() const { return reps_; }
 
-  // Sum of weights of the representatives within the cone around w: kd-tree or linear scan.
-  double coneSum(const glm::vec3& w) const;
-  double coneSumLinear(const glm::vec3& w) const;
+  static int cellOf(const glm::vec3& w);
+  static glm::vec3 cellCentre(int cell);
+  // Cells whose centres lie within the cone of cosine cosCone around the unit vector d: the cone
+  // query (nanoflann kd-tree over the cell centres), and a brute-force scan for tests.
+  static void coneCells(const glm::vec3& d, float cosCone, std::vector<uint32_t>& cells);
+  static void coneCellsLinear(const glm::vec3& d, float cosCone, std::vector<uint32_t>& cells);
 
   size_t memoryBytes() const;
 
  private:
-  struct Index;  // nanoflann kd-tree over the unit vectors (only for many representatives)
-  std::vector<GuideRepresentative> reps_;
-  Distribution1D choice_;
-  std::unique_ptr<Index> index_;
+  Distribution1D choice_;  // cells by their share of the weight (empty when Z = 0)
   double total_ = 0.0;
-  float cosCone_ = 1.0f, chord2_ = 0.0f, coneSolidAngle_ = 0.0f, defensive_ = 0.01f;
+  float cellDensity_ = 0.0f;  // (1 - eps) / cell solid angle: pdf = cellDensity_ pmf(cell) + eps / (4 pi)
+  float defensive_ = 0.01f;
+  size_t representativeCount_ = 0;
 };
 
 }  // namespace vpl

@@ -6,6 +6,7 @@
 #include <numbers>
 #include <sstream>
 #include <vector>
+#include "render/sampling/equal_area_map.h"
 
 namespace vpl::test {
 namespace {
@@ -48,6 +49,64 @@ double regularizedGammaP(double a, double x) {
 }
 
 }  // namespace
+
+namespace {
+ChiSquareResult compareCounts(const std::vector<double>& observed, const std::vector<double>& expected, int sampleCount,
+                              const std::function<std::string(int)>& binName) {
+  const int binCount = int(observed.size()) - 1;
+// Pool the low-expectation bins (in increasing order of expectation) as Nori and pbrt do.
+  std::vector<int> order(binCount + 1);
+  for (int k = 0; k <= binCount; ++k) order[k] = k;
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return expected[a] < expected[b]; });
+
+  ChiSquareResult r;
+  double pooledObs = 0.0, pooledExp = 0.0;
+  int used = 0;
+  struct Worst { double contribution; int bin; double obs, exp; };
+  std::vector<Worst> worst;
+  for (int k : order) {
+    if (expected[k] == 0.0 && observed[k] > 0.001 * sampleCount + 10.0) {
+      // Many samples where the pdf says none can be (a few are quadrature misses at support edges).
+      r.statistic = std::numeric_limits<double>::infinity();
+      worst.push_back({r.statistic, k, observed[k], 0.0});
+      continue;
+    }
+    if (expected[k] < 5.0) {
+      pooledObs += observed[k];
+      pooledExp += expected[k];
+      if (pooledExp < 5.0) continue;
+      const double diff = pooledObs - pooledExp;
+      r.statistic += diff * diff / pooledExp;
+      pooledObs = pooledExp = 0.0;
+      ++used;
+      continue;
+    }
+    const double diff = observed[k] - expected[k];
+    const double c = diff * diff / expected[k];
+    r.statistic += c;
+    worst.push_back({c, k, observed[k], expected[k]});
+    ++used;
+  }
+  if (pooledExp > 0.0) {
+    const double diff = pooledObs - pooledExp;
+    r.statistic += diff * diff / pooledExp;
+    ++used;
+  }
+  r.degreesOfFreedom = std::max(1, used - 1);
+  r.pValue = std::isfinite(r.statistic) ? chiSquareTail(r.statistic, r.degreesOfFreedom) : 0.0;
+
+  std::sort(worst.begin(), worst.end(), [](const Worst& a, const Worst& b) { return a.contribution > b.contribution; });
+  std::ostringstream os;
+  os << "chi2=" << r.statistic << " dof=" << r.degreesOfFreedom << " p=" << r.pValue << "; worst bins:";
+  for (size_t k = 0; k < std::min<size_t>(5, worst.size()); ++k) {
+    const int b = worst[k].bin;
+    os << " [" << binName(b) << " obs " << worst[k].obs << " exp " << worst[k].exp << "]";
+  }
+  r.report = os.str();
+  return r;
+}
+}  // namespace
+
 
 double chiSquareTail(double statistic, int dof) {
   if (dof <= 0) return 1.0;
@@ -105,57 +164,38 @@ ChiSquareResult chiSquareSphere(const std::function<glm::vec3()>& sample,
   }
   expected[binCount] = std::max(0.0, 1.0 - total) * sampleCount;
 
-  // Pool the low-expectation bins (in increasing order of expectation) as Nori and pbrt do.
-  std::vector<int> order(binCount + 1);
-  for (int k = 0; k <= binCount; ++k) order[k] = k;
-  std::sort(order.begin(), order.end(), [&](int a, int b) { return expected[a] < expected[b]; });
+  return compareCounts(observed, expected, sampleCount, [phiBins, binCount](int b) {
+    return b == binCount ? std::string("none") : std::to_string(b / phiBins) + "," + std::to_string(b % phiBins);
+  });
+}
 
-  ChiSquareResult r;
-  double pooledObs = 0.0, pooledExp = 0.0;
-  int used = 0;
-  struct Worst { double contribution; int bin; double obs, exp; };
-  std::vector<Worst> worst;
-  for (int k : order) {
-    if (expected[k] == 0.0 && observed[k] > 0.001 * sampleCount + 10.0) {
-      // Many samples where the pdf says none can be (a few are quadrature misses at support edges).
-      r.statistic = std::numeric_limits<double>::infinity();
-      worst.push_back({r.statistic, k, observed[k], 0.0});
-      continue;
-    }
-    if (expected[k] < 5.0) {
-      pooledObs += observed[k];
-      pooledExp += expected[k];
-      if (pooledExp < 5.0) continue;
-      const double diff = pooledObs - pooledExp;
-      r.statistic += diff * diff / pooledExp;
-      pooledObs = pooledExp = 0.0;
-      ++used;
-      continue;
-    }
-    const double diff = observed[k] - expected[k];
-    const double c = diff * diff / expected[k];
-    r.statistic += c;
-    worst.push_back({c, k, observed[k], expected[k]});
-    ++used;
+ChiSquareResult chiSquareEqualArea(const std::function<glm::vec3()>& sample,
+                                   const std::function<double(const glm::vec3&)>& pdf, int sampleCount, int resolution,
+                                   int subdivisions) {
+  const int binCount = resolution * resolution;
+  std::vector<double> observed(binCount + 1, 0.0), expected(binCount + 1, 0.0);  // last = "no sample"
+  for (int s = 0; s < sampleCount; ++s) {
+    const glm::vec3 d = sample();
+    const float len2 = glm::dot(d, d);
+    if (!(len2 > 0.5f)) observed[binCount] += 1.0;
+    else observed[equalAreaCell(d / std::sqrt(len2), resolution)] += 1.0;
   }
-  if (pooledExp > 0.0) {
-    const double diff = pooledObs - pooledExp;
-    r.statistic += diff * diff / pooledExp;
-    ++used;
+  // Each cell holds 4 pi / N steradians, so its integral is the mean of the pdf over a sub-grid.
+  double total = 0.0;
+  for (int c = 0; c < binCount; ++c) {
+    double sum = 0.0;
+    for (int a = 0; a < subdivisions; ++a)
+      for (int b = 0; b < subdivisions; ++b)
+        sum += pdf(equalAreaSquareToSphere({float((c % resolution + (a + 0.5) / subdivisions) / resolution),
+                                            float((c / resolution + (b + 0.5) / subdivisions) / resolution)}));
+    const double integral = sum / (subdivisions * subdivisions) * 4.0 * kPi / binCount;
+    expected[c] = integral * sampleCount;
+    total += integral;
   }
-  r.degreesOfFreedom = std::max(1, used - 1);
-  r.pValue = std::isfinite(r.statistic) ? chiSquareTail(r.statistic, r.degreesOfFreedom) : 0.0;
-
-  std::sort(worst.begin(), worst.end(), [](const Worst& a, const Worst& b) { return a.contribution > b.contribution; });
-  std::ostringstream os;
-  os << "chi2=" << r.statistic << " dof=" << r.degreesOfFreedom << " p=" << r.pValue << "; worst bins:";
-  for (size_t k = 0; k < std::min<size_t>(5, worst.size()); ++k) {
-    const int b = worst[k].bin;
-    os << " [" << (b == binCount ? std::string("none") : std::to_string(b / phiBins) + "," + std::to_string(b % phiBins))
-       << " obs " << worst[k].obs << " exp " << worst[k].exp << "]";
-  }
-  r.report = os.str();
-  return r;
+  expected[binCount] = std::max(0.0, 1.0 - total) * sampleCount;
+  return compareCounts(observed, expected, sampleCount, [resolution, binCount](int b) {
+    return b == binCount ? std::string("none") : std::to_string(b % resolution) + "," + std::to_string(b / resolution);
+  });
 }
 
 std::string sourceDir() { return VPLVIEW_SOURCE_DIR; }

@@ -27,6 +27,13 @@ ChiSquareResult chiSquareSphere(const std::function<glm::vec3()>& sample,
 // renormalise: the sampler never fails and its pdf's integral is tested elsewhere, so scale the
 // expected counts to sum to the sample count (removes quadrature error of very peaked pdfs).
 
+// The same test with the cells of the equal-area square map (render/sampling/equal_area_map.h) as
+// bins, resolution x resolution of them: exact for pdfs that are constant over cells of that grid
+// (the guide's), where the (cos theta, phi) bins would cut through their steps.
+ChiSquareResult chiSquareEqualArea(const std::function<glm::vec3()>& sample,
+                                   const std::function<double(const glm::vec3&)>& pdf, int sampleCount, int resolution,
+                                   int subdivisions = 4);
+
 // Integral of f over the unit sphere by a fine (cos theta, phi) midpoint grid.
 double integrateSphere(const std::function<double(const glm::vec3&)>& f, int cosThetaSteps = 512,
                        int phiSteps = 1024);

@@ -1,5 +1,7 @@
 // The guide distribution, its Metropolis chain and the cache-point lookup, against their definitions.
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <numbers>
 #include "render/guide/guide_distribution.h"
 #include "render/guide/guide_field.h"
@@ -56,16 +58,41 @@ TEST(GuideDistribution, TargetIntegratesToTotalWeight) {
 }
 
 TEST(GuideDistribution, KdTreeConeQueryEqualsLinearScan) {
-  for (const Case& c : cases()) {
-    const GuideDistribution d(randomReps(c.reps, 4, c.clustered), c.coneDegrees * kDeg, 0.01f);
-    Rng rng(5);
-    for (int i = 0; i < 2000; ++i) {
-      // Half the queries right at representatives, where cones overlap the most.
-      const glm::vec3 w = (i % 2 == 0 && d.size() > 0) ? d.representatives()[i % d.size()].direction
-                                                       : sampleUniformSphere(rng.uniform2());
-      ASSERT_NEAR(d.coneSum(w), d.coneSumLinear(w), 1e-9 + 1e-6 * d.coneSumLinear(w)) << c.name;
+  Rng rng(5);
+  std::vector<uint32_t> tree, linear;
+  for (float degrees : {1.0f, 3.0f, 10.0f, 20.4f, 45.0f, 120.0f, 180.0f}) {
+    for (int i = 0; i < 500; ++i) {
+      // A quarter of the queries right at cell centres, where the cone's edge passes through neighbours.
+      const glm::vec3 w = i % 4 == 0 ? GuideDistribution::cellCentre(int(rng.below(GuideDistribution::kCells)))
+                                     : sampleUniformSphere(rng.uniform2());
+      tree.clear();
+      linear.clear();
+      GuideDistribution::coneCells(w, std::cos(degrees * kDeg), tree);
+      GuideDistribution::coneCellsLinear(w, std::cos(degrees * kDeg), linear);
+      std::sort(tree.begin(), tree.end());
+      // The two may round a centre lying on the cone's edge differently; nothing else may differ.
+      std::vector<uint32_t> differ;
+      std::set_symmetric_difference(tree.begin(), tree.end(), linear.begin(), linear.end(), std::back_inserter(differ));
+      for (uint32_t c : differ)
+        ASSERT_NEAR(glm::dot(GuideDistribution::cellCentre(int(c)), w), std::cos(degrees * kDeg), 1e-5f) << degrees << " degrees";
+      ASSERT_LE(differ.size(), 2u);
     }
   }
+}
+
+TEST(GuideDistribution, TargetIsTheConeAverageAtCellCentres) {
+  // One representative: its weight spread over the cells whose centres see it within the cone.
+  const glm::vec3 dir = glm::normalize(glm::vec3(0.2f, -0.5f, 0.7f));
+  const GuideDistribution d({{dir, 3.0f}}, 20.0f * kDeg, 0.01f);
+  std::vector<uint32_t> cells;
+  GuideDistribution::coneCellsLinear(dir, std::cos(20.0f * kDeg), cells);
+  ASSERT_GT(cells.size(), 10u);
+  // The cone's cells hold the same solid angle as the cone, within the grid's resolution.
+  const double coneSolidAngle = 2.0 * std::numbers::pi * (1.0 - std::cos(20.0 * kDeg));
+  EXPECT_NEAR(double(cells.size()) * GuideDistribution::kCellSolidAngle, coneSolidAngle, 0.15 * coneSolidAngle);
+  const double expected = 3.0 / (double(cells.size()) * GuideDistribution::kCellSolidAngle);
+  for (uint32_t c : cells) ASSERT_NEAR(d.target(GuideDistribution::cellCentre(int(c))), expected, 1e-5 * expected);
+  EXPECT_EQ(d.target(-dir), 0.0f);
 }
 
 TEST(GuideDistribution, ZeroWeightIsUniform) {
@@ -81,9 +108,8 @@ TEST(GuideDistribution, ExactSamplerMatchesPdf) {
   for (const Case& c : cases()) {
     const GuideDistribution d(randomReps(c.reps, 6, c.clustered), c.coneDegrees * kDeg, 0.01f);
     Rng rng(7);
-    const int bins = c.coneDegrees < 10 ? 96 : 32;
-    const auto r = test::chiSquareSphere([&] { return d.sample(rng); }, [&](const glm::vec3& w) { return double(d.pdf(w)); },
-                                         200000, bins, 2 * bins, c.coneDegrees < 10 ? 16 : 8, true);
+    const auto r = test::chiSquareEqualArea([&] { return d.sample(rng); }, [&](const glm::vec3& w) { return double(d.pdf(w)); },
+                                            200000, 2 * GuideDistribution::kResolution);
     EXPECT_GT(r.pValue, 1e-4) << c.name << ": " << r.report;
   }
 }
@@ -102,9 +128,8 @@ TEST(Metropolis, IndependentChainsAreDistributedByThePdf) {
       for (int k = 0; k < 5; ++k) w = chain.next(d, settings, rng, stats);
       return w;
     };
-    const int bins = c.coneDegrees < 10 ? 96 : 32;
-    const auto r = test::chiSquareSphere(sample, [&](const glm::vec3& w) { return double(d.pdf(w)); }, 100000, bins,
-                                         2 * bins, c.coneDegrees < 10 ? 16 : 8, true);
+    const auto r = test::chiSquareEqualArea(sample, [&](const glm::vec3& w) { return double(d.pdf(w)); }, 100000,
+                                            GuideDistribution::kResolution);
     EXPECT_GT(r.pValue, 1e-4) << c.name << ": " << r.report;
     const double acceptance = double(stats.accepted) / double(stats.proposals);
     EXPECT_GT(acceptance, 0.005) << c.name;

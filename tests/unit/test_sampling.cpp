@@ -4,6 +4,7 @@
 #include <vector>
 #include "render/core/frame.h"
 #include "render/sampling/distribution_1d.h"
+#include "render/sampling/equal_area_map.h"
 #include "render/sampling/rng.h"
 #include "render/sampling/warps.h"
 #include "tests/unit/support.h"
@@ -124,6 +125,37 @@ TEST(Warps, TriangleBarycentricsAreUniform) {
   const double p = chiSquare2d([&] { return sampleUniformTriangle(rng.uniform2()); },
                                [](glm::vec2 q) { return q.x + q.y <= 1.0f; }, 0.5, 24, 200000);
   EXPECT_GT(p, kSignificance);
+}
+
+TEST(EqualAreaMap, UniformSquareIsUniformSphere) {
+  Rng rng(11);
+  const auto r = test::chiSquareSphere([&] { return equalAreaSquareToSphere(rng.uniform2()); },
+                                       [](const glm::vec3&) { return double(uniformSpherePdf()); }, 200000);
+  EXPECT_GT(r.pValue, kSignificance) << r.report;
+}
+
+TEST(EqualAreaMap, InverseRoundTripsAndCellsHoldEqualShares) {
+  Rng rng(12);
+  for (int i = 0; i < 100000; ++i) {
+    const glm::vec2 p = rng.uniform2();
+    const glm::vec3 w = equalAreaSquareToSphere(p);
+    ASSERT_NEAR(glm::length(w), 1.0f, 1e-5f);
+    const glm::vec2 q = equalAreaSphereToSquare(w);
+    ASSERT_NEAR(q.x, p.x, 2e-5f) << p.x << "," << p.y;
+    ASSERT_NEAR(q.y, p.y, 2e-5f) << p.x << "," << p.y;
+  }
+  // Uniform directions fall into the cells of an 8x8 grid in equal shares (chi-square, 63 dof).
+  constexpr int kRes = 8, kCount = 640000;
+  std::vector<int> counts(kRes * kRes, 0);
+  for (int i = 0; i < kCount; ++i) ++counts[size_t(equalAreaCell(sampleUniformSphere(rng.uniform2()), kRes))];
+  double statistic = 0.0;
+  const double expected = double(kCount) / (kRes * kRes);
+  for (int c : counts) statistic += (c - expected) * (c - expected) / expected;
+  EXPECT_GT(test::chiSquareTail(statistic, kRes * kRes - 1), kSignificance) << statistic;
+  // The poles and the folds of the octahedron map where they should.
+  EXPECT_NEAR(equalAreaSquareToSphere({0.5f, 0.5f}).z, 1.0f, 1e-6f);
+  EXPECT_NEAR(equalAreaSquareToSphere({0.0f, 0.0f}).z, -1.0f, 1e-6f);
+  EXPECT_NEAR(equalAreaSquareToSphere({1.0f, 0.5f}).z, 0.0f, 1e-6f);
 }
 
 TEST(Distribution1D, SamplesFollowWeightsAndSkipZeros) {

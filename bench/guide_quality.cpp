@@ -1,0 +1,117 @@
+// How good is the VPL guide as a sampling density, before any cost is counted? At sampled cache
+// points it estimates the indirect light that the continuation direction must find,
+//   g(w) = f(wo, w) cos(w) L_ind(w),   L_ind = what the next vertex reflects (its emission excluded),
+// on a stratified set of directions (L_ind by brdf path tracing), and prints for each strategy the
+// variance of the one-sample estimator g/p relative to BSDF sampling: below 1 the strategy beats
+// the BSDF at equal sample count. Usage:
+//   guide_quality SCENE [cache points=48] [directions=4096] [paths per direction=8] [width=320] [height=240]
+// Environment overrides of the defaults: GQ_VPLS (count), GQ_CONE (degrees), GQ_DEFENSIVE, GQ_CLAMP.
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <vector>
+#include <tbb/parallel_for.h>
+#include "render/core/color.h"
+#include "render/core/error.h"
+#include "render/guide/guide_builder.h"
+#include "render/scene/camera.h"
+#include "render/scene/gltf_loader.h"
+#include "render/sampling/warps.h"
+
+using namespace vpl;
+
+namespace {
+
+struct Moments {
+  double mean = 0.0, bsdf = 0.0, guide = 0.0, mis = 0.0;  // integral, then second moments E_p[(g/p)^2]
+};
+
+// Stratified uniform sphere directions: each carries g and all strategies' pdfs.
+Moments measure(const RenderScene& scene, const PathTracer& tracer, const GuideField& field, int c, const glm::vec3& wo,
+                int directions, int paths, uint64_t seed) {
+  const CachePoint& cp = field.point(c);
+  SurfaceHit at;
+  at.position = cp.position;
+  at.shadingNormal = cp.normal;
+  at.geometricNormal = cp.normal;
+  const Bsdf bsdf = scene.bsdf(at);
+  const int side = int(std::sqrt(double(directions)));
+  const float pBsdf = field.settings().bsdfProbability;
+  Moments m;
+  Rng rng(seed, uint64_t(c));
+  BsdfContinuation continuation;
+  PathStats stats;
+  for (int i = 0; i < side * side; ++i) {
+    const glm::vec2 u((float(i % side) + rng.uniform()) / side, (float(i / side) + rng.uniform()) / side);
+    const glm::vec3 w = sampleUniformSphere(u);
+    const glm::vec3 f = bsdf.eval(wo, w);
+    if (isBlack(f) || glm::dot(w, cp.normal) <= 0.0f) continue;
+    glm::vec3 l(0.0f);
+    const Ray ray = spawnRay(at, w);
+    for (int k = 0; k < paths; ++k) l += tracer.radiance(ray, rng, continuation, stats);
+    const RayHit hit = scene.accel().intersect(ray);
+    if (hit.valid()) {
+      const SurfaceHit s = scene.surface(ray, hit);
+      l -= float(paths) * scene.emitters().emitted(s, -w);  // next-event estimation's share
+    }
+    const double g = std::max(0.0f, luminance(f * l)) / paths;
+    const double pu = uniformSpherePdf(), pb = bsdf.pdf(wo, w), pg = cp.distribution.pdf(w);
+    const double pm = pBsdf * pb + (1.0 - pBsdf) * pg;
+    const double n = double(side) * side;
+    m.mean += g / pu / n;
+    m.bsdf += (pb > 0 ? g * g / (pb * pu) : (g > 0 ? INFINITY : 0.0)) / n;
+    m.guide += g * g / (pg * pu) / n;
+    m.mis += g * g / (pm * pu) / n;
+  }
+  return m;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    std::fprintf(stderr, "usage: guide_quality SCENE [cache points] [directions] [paths per direction] [width] [height]\n");
+    return 2;
+  }
+  const int points = argc > 2 ? std::atoi(argv[2]) : 48, directions = argc > 3 ? std::atoi(argv[3]) : 4096;
+  const int paths = argc > 4 ? std::atoi(argv[4]) : 8;
+  const int width = argc > 5 ? std::atoi(argv[5]) : 320, height = argc > 6 ? std::atoi(argv[6]) : 240;
+  try {
+    const RenderScene scene(loadGltf(argv[1]));
+    const Camera camera(defaultCamera(scene.data()), width, height);
+    PreviewSettings preview;
+    GuideSettings guideSettings;
+    if (const char* v = std::getenv("GQ_VPLS")) preview.vpl.count = std::atoi(v);
+    if (const char* v = std::getenv("GQ_CONE")) guideSettings.coneAngle = float(std::atof(v) * kPi / 180.0);
+    if (const char* v = std::getenv("GQ_DEFENSIVE")) guideSettings.defensive = float(std::atof(v));
+    if (const char* v = std::getenv("GQ_CLAMP")) preview.clampFraction = float(std::atof(v));
+    const VplField vplField = buildVplField(scene, camera, std::make_shared<VplSet>(traceVpls(scene, preview.vpl)), preview);
+    const GuideField field = buildGuideField(scene, vplField, guideSettings);
+    const PathTracer tracer(scene, PathTracerSettings{});
+    std::vector<Moments> results(size_t(std::min<size_t>(points, field.size())));
+    tbb::parallel_for(size_t(0), results.size(), [&](size_t i) {
+      const int c = int(i * field.size() / results.size());
+      const uint32_t g = vplField.tree.slices[size_t(c)].representative;
+      results[i] = measure(scene, tracer, field, c, vplField.gather.wo[g], directions, paths, 7);
+    });
+    std::printf("%5s %10s %10s %10s %10s %6s\n", "cache", "integral", "var guide", "var mis", "(/ var bsdf)", "reps");
+    std::vector<double> guideRatio, misRatio;
+    for (size_t i = 0; i < results.size(); ++i) {
+      const Moments& m = results[i];
+      const double vb = m.bsdf - m.mean * m.mean, vg = m.guide - m.mean * m.mean, vm = m.mis - m.mean * m.mean;
+      if (!(vb > 0)) continue;
+      guideRatio.push_back(vg / vb);
+      misRatio.push_back(vm / vb);
+      const int c = int(i * field.size() / results.size());
+      std::printf("%5d %10.4g %10.3f %10.3f %10s %6zu\n", c, m.mean, vg / vb, vm / vb, "", field.point(c).distribution.size());
+    }
+    auto median = [](std::vector<double> v) { std::sort(v.begin(), v.end()); return v.empty() ? 0.0 : v[v.size() / 2]; };
+    auto mean = [](const std::vector<double>& v) { double s = 0; for (double x : v) s += x; return v.empty() ? 0.0 : s / v.size(); };
+    std::printf("variance relative to BSDF sampling: guide median %.3f mean %.3f, mis median %.3f mean %.3f\n",
+                median(guideRatio), mean(guideRatio), median(misRatio), mean(misRatio));
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "guide_quality: %s\n", e.what());
+    return 2;
+  }
+  return 0;
+}
