@@ -176,28 +176,51 @@ TEST(Metropolis, SameSeedSameChain) {
   for (int i = 0; i < 100; ++i) ASSERT_EQ(ca.next(d, settings, a, s), cb.next(d, settings, b, s));
 }
 
-TEST(GuideField, LookupEqualsBruteForce) {
+TEST(GuideField, LookupIsTheNearestAgreeingCachePoint) {
   Rng rng(13);
   std::vector<CachePoint> points(300);
-  for (auto& p : points) {
+  for (size_t i = 0; i < points.size(); ++i) {
+    CachePoint& p = points[i];
     p.position = glm::vec3(rng.uniform(), rng.uniform(), rng.uniform()) * 10.0f;
-    p.normal = sampleUniformSphere(rng.uniform2());
-    p.radius = 0.2f + rng.uniform();
+    p.normal = i % 3 ? sampleUniformSphere(rng.uniform2()) : glm::vec3(0, 0, 1);
+    // Mostly small, a few huge (the grid's list of large spheres), one degenerate.
+    p.radius = i == 7 ? 0.0f : (i % 50 == 0 ? 8.0f : 0.2f + rng.uniform());
   }
   GuideSettings settings;
+  const std::vector<CachePoint> copy = [&] {
+    std::vector<CachePoint> c(points.size());
+    for (size_t i = 0; i < c.size(); ++i) c[i] = {points[i].position, points[i].normal, points[i].radius, {}};
+    return c;
+  }();
   const GuideField field(std::move(points), settings);
+  auto bruteForce = [&](const glm::vec3& p, const glm::vec3& n) {
+    int best = -1;
+    float bestDist2 = INFINITY;
+    for (size_t i = 0; i < copy.size(); ++i) {
+      const float r = copy[i].radius * settings.lookupRadiusScale;
+      const float d2 = glm::dot(copy[i].position - p, copy[i].position - p);
+      if (r > 0.0f && d2 <= r * r && glm::dot(copy[i].normal, n) >= settings.lookupCosNormal && d2 < bestDist2) {
+        best = int(i);
+        bestDist2 = d2;
+      }
+    }
+    return best;
+  };
   int hits = 0;
-  for (int i = 0; i < 5000; ++i) {
-    const glm::vec3 p = glm::vec3(rng.uniform(), rng.uniform(), rng.uniform()) * 10.0f;
+  for (int i = 0; i < 20000; ++i) {
+    const glm::vec3 p = glm::vec3(rng.uniform(), rng.uniform(), rng.uniform()) * 12.0f - 1.0f;
     const glm::vec3 n = i % 2 ? field.point(int(i % field.size())).normal : sampleUniformSphere(rng.uniform2());
     const int got = field.lookup(p, n);
+    ASSERT_EQ(got, bruteForce(p, n)) << i;
     ASSERT_EQ(got, field.lookupLinear(p, n)) << i;
     hits += got >= 0;
   }
-  EXPECT_GT(hits, 100);
-  // Far away, or facing the other way: no cache point.
+  EXPECT_GT(hits, 1000);
+  // Far away, facing the other way, non-finite: no cache point.
   EXPECT_EQ(field.lookup(glm::vec3(100.0f), glm::vec3(0, 0, 1)), -1);
-  EXPECT_EQ(field.lookup(field.point(0).position, -field.point(0).normal), -1);
+  EXPECT_EQ(field.lookup(field.point(1).position, -field.point(1).normal), -1);
+  EXPECT_EQ(field.lookup(glm::vec3(NAN), glm::vec3(0, 0, 1)), -1);
+  EXPECT_EQ(field.lookup(glm::vec3(1e30f), glm::vec3(0, 0, 1)), -1);
   EXPECT_EQ(GuideField().lookup(glm::vec3(0.0f), glm::vec3(0, 0, 1)), -1);
 }
 
