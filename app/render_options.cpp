@@ -57,6 +57,9 @@ void RenderOptions::addTo(CLI::App& command, bool requireOut) {
   command.add_option("--vpl-clamp", preview.clampFraction, "geometry clamp distance as a fraction of the scene diagonal")
       ->check(CLI::Range(0.0f, 0.99f));
   command.add_option("--cone", coneDegrees, "guide cone half-angle, degrees")->check(CLI::Range(0.01f, 180.0f));
+  command.add_option("--cone-spread", guide.spreadScale,
+                     "a cluster's guide cone is at least atan(this x its spread / distance); 0: the fixed cone only")
+      ->check(CLI::Range(0.0f, 1000.0f));
   command.add_option("--defensive", guide.defensive, "uniform share of the guide pdf")->check(CLI::Range(1e-6f, 1.0f));
   command.add_option("--uniform-mutation", guide.uniformMutation, "Metropolis: probability of an independent direction")
       ->check(CLI::Range(0.0f, 1.0f));

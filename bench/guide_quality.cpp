@@ -5,7 +5,7 @@
 // variance of the one-sample estimator g/p relative to BSDF sampling: below 1 the strategy beats
 // the BSDF at equal sample count. Usage:
 //   guide_quality SCENE [cache points=48] [directions=4096] [paths per direction=8] [width=320] [height=240]
-// Environment overrides of the defaults: GQ_VPLS (count), GQ_CONE (degrees), GQ_DEFENSIVE, GQ_CLAMP.
+// Environment overrides of the defaults: GQ_VPLS (count), GQ_CONE (degrees), GQ_DEFENSIVE, GQ_CLAMP, GQ_SPREAD.
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -62,7 +62,13 @@ Moments measure(const RenderScene& scene, const PathTracer& tracer, const GuideF
     m.bsdf += (pb > 0 ? g * g / (pb * pu) : (g > 0 ? INFINITY : 0.0)) / n;
     m.guide += g * g / (pg * pu) / n;
     m.mis += g * g / (pm * pu) / n;
+    if (std::getenv("GQ_DUMP") && std::atoi(std::getenv("GQ_DUMP")) == c && g > 0)
+      std::fprintf(stderr, "w %6.3f %6.3f %6.3f cos %.3f g %.4g pg %.4g pb %.4g g2/pg %.4g\n", w.x, w.y, w.z,
+                   glm::dot(w, cp.normal), g, pg, pb, g * g / (pg * pu) / n);
   }
+  if (std::getenv("GQ_DUMP") && std::atoi(std::getenv("GQ_DUMP")) == c)
+    std::fprintf(stderr, "cache %d at %.3f %.3f %.3f n %.3f %.3f %.3f radius %.3f\n", c, cp.position.x, cp.position.y,
+                 cp.position.z, cp.normal.x, cp.normal.y, cp.normal.z, cp.radius);
   return m;
 }
 
@@ -84,6 +90,7 @@ int main(int argc, char** argv) {
     if (const char* v = std::getenv("GQ_VPLS")) preview.vpl.count = std::atoi(v);
     if (const char* v = std::getenv("GQ_CONE")) guideSettings.coneAngle = float(std::atof(v) * kPi / 180.0);
     if (const char* v = std::getenv("GQ_DEFENSIVE")) guideSettings.defensive = float(std::atof(v));
+    if (const char* v = std::getenv("GQ_SPREAD")) guideSettings.spreadScale = float(std::atof(v));
     if (const char* v = std::getenv("GQ_CLAMP")) preview.clampFraction = float(std::atof(v));
     const VplField vplField = buildVplField(scene, camera, std::make_shared<VplSet>(traceVpls(scene, preview.vpl)), preview);
     const GuideField field = buildGuideField(scene, vplField, guideSettings);

@@ -260,6 +260,15 @@ LightSliceResult clusterLightSlice(std::span<const Vpl> vpls, std::span<const Ga
       }
       const Distribution1D pick(power);
       cl.representative = pick.empty() ? clusters[c][0] : clusters[c][pick.sample(rng.uniform())];
+      if (cl.totalPower > 0.0f) {
+        double spread2 = 0.0;
+        const glm::vec3 centre = vpls[cl.representative].position;
+        for (size_t i = 0; i < clusters[c].size(); ++i) {
+          const glm::vec3 d = vpls[clusters[c][i]].position - centre;
+          spread2 += double(power[i]) * glm::dot(d, d);
+        }
+        cl.spread = float(std::sqrt(spread2 / cl.totalPower));
+      }
       const float repPower = vpls[cl.representative].power();
       cl.estimate = repPower > 0.0f ? transport.contribution(s, cl.representative, true) * (cl.totalPower / repPower) : 0.0f;
       ++evals;

@@ -44,6 +44,7 @@ struct VplCluster {
   glm::vec3 totalFlux{0.0f};            // sum of member fluxes (W)
   float totalPower = 0.0f;              // sum of member powers (luminance of flux)
   float estimate = 0.0f;                // representative's contribution at the slice representative, x totalPower / its power, with visibility
+  float spread = 0.0f;                  // power-weighted RMS distance of the members from the representative (world units)
   uint32_t memberBegin = 0, memberEnd = 0;  // into SliceClusters::members when keepMembers
 };
 

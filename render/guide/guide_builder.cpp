@@ -37,7 +37,9 @@ GuideField buildGuideField(const RenderScene& scene, const VplField& field, cons
       const float weight = leaving * cosReceiver / std::max(dist2, field.minDistance * field.minDistance);
       if (!(weight > 0.0f) || !std::isfinite(weight)) continue;
       if (scene.accel().occluded(spawnShadowRay(hit, dir, std::sqrt(dist2)))) continue;
-      reps.push_back({dir, weight});
+      // A cluster seen under a wide angle (near, or large) spreads over the angle it subtends.
+      const float dist = std::sqrt(dist2);
+      reps.push_back({dir, weight, std::atan2(settings.spreadScale * c.spread, dist)});
     }
     cp.distribution = GuideDistribution(std::move(reps), settings.coneAngle, settings.defensive);
   });

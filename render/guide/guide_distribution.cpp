@@ -80,8 +80,11 @@ void GuideDistribution::coneCellsLinear(const glm::vec3& d, float cosCone, std::
 GuideDistribution::GuideDistribution(const std::vector<GuideRepresentative>& representatives, float coneAngle,
                                      float defensive)
     : defensive_(defensive), representativeCount_(representatives.size()) {
-  const float sinHalf = std::sin(0.5f * coneAngle);
-  const float cosCone = 1.0f - 2.0f * sinHalf * sinHalf;
+  auto cosineOf = [](float angle) {
+    const float sinHalf = std::sin(0.5f * std::min(angle, 3.14159265f));
+    return 1.0f - 2.0f * sinHalf * sinHalf;
+  };
+  const float cosDefault = cosineOf(coneAngle);
   std::vector<float> mass(kCells, 0.0f);
   std::vector<uint32_t> cells;
   for (const GuideRepresentative& r : representatives) {
@@ -89,7 +92,7 @@ GuideDistribution::GuideDistribution(const std::vector<GuideRepresentative>& rep
     if (!(r.weight > 0.0f) || !std::isfinite(r.weight) || !(len > 0.0f) || !std::isfinite(len)) continue;
     const glm::vec3 d = r.direction / len;
     cells.clear();
-    coneCells(d, cosCone, cells);
+    coneCells(d, r.coneAngle > coneAngle ? cosineOf(r.coneAngle) : cosDefault, cells);
     if (cells.empty()) cells.push_back(uint32_t(cellOf(d)));  // a cone narrower than a cell
     const float share = r.weight / float(cells.size());
     for (uint32_t c : cells) mass[c] += share;

@@ -1,7 +1,8 @@
 // The directional distribution of one cache point (Hua & Low 2015): representatives are the
 // directions to its VPL clusters with weights (their estimated contribution, W/sr-like luminance).
 // Each representative spreads its weight evenly over the cells of an equal-area map of the sphere
-// (render/sampling/equal_area_map.h) whose centres lie within a cone of half-angle thetaC around it,
+// (render/sampling/equal_area_map.h) whose centres lie within a cone around it (half-angle thetaC, or
+// wider for a representative that asks for it, such as a large cluster close to the cache point),
 // or over its own cell when the cone holds no centre. The target f(w) is the tabulated density of
 // w's cell: the mean incoming radiance predicted around w, as the authors' lookup radius on an
 // equal-area square. Its sphere integral is exactly Z = sum of weights, and
@@ -19,6 +20,7 @@ namespace vpl {
 struct GuideRepresentative {
   glm::vec3 direction{0, 0, 1};  // unit, world space, from the cache point towards the cluster
   float weight = 0.0f;           // >= 0
+  float coneAngle = 0.0f;        // half-angle of its cone (radians); at most the distribution's own is used
 };
 
 class GuideDistribution {

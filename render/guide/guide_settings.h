@@ -10,6 +10,9 @@
 //   bsdfProbability    float  0.5    one-sample MIS: probability of sampling the BSDF instead of the guide
 //   lookupCosNormal    float  0.9    a vertex uses a cache point only if their normals agree this well
 //   lookupRadiusScale  float  1.5    ... and it lies within this multiple of the cache point's slice radius
+//   spreadScale        float  2      a cluster's cone is at least atan(spreadScale x its RMS spread / distance): the
+//                                    angle its members subtend (measured: 2 cut the per-sample relMSE of `mixture`
+//                                    5x on two_rooms and 11x on the interior against 0, and left `mis` unchanged)
 #pragma once
 #include <cmath>
 #include <string>
@@ -25,6 +28,7 @@ struct GuideSettings {
   float bsdfProbability = 0.5f;
   float lookupCosNormal = 0.9f;
   float lookupRadiusScale = 1.5f;
+  float spreadScale = 2.0f;
 
   std::string validate() const {
     if (!(coneAngle > 1e-4f && coneAngle <= 3.1416f)) return "guide cone angle must be in (1e-4, pi] radians";
@@ -35,6 +39,7 @@ struct GuideSettings {
     if (!(bsdfProbability >= 0.0f && bsdfProbability <= 1.0f)) return "BSDF selection probability must be in [0, 1]";
     if (!(lookupCosNormal >= -1.0f && lookupCosNormal <= 1.0f)) return "lookup normal cosine must be in [-1, 1]";
     if (!(lookupRadiusScale > 0.0f)) return "lookup radius scale must be positive";
+    if (!(spreadScale >= 0.0f && spreadScale <= 1e3f)) return "cone spread scale must be in [0, 1000]";
     return {};
   }
 };

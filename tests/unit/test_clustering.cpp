@@ -176,6 +176,15 @@ TEST(LightSlice, EveryVplInExactlyOneClusterAndFluxIsConserved) {
         repIsMember |= sc.members[i] == c.representative;
       }
       EXPECT_TRUE(repIsMember);
+      // The spread is the power-weighted RMS distance of the members from the representative.
+      double spread2 = 0.0, power = 0.0;
+      for (uint32_t i = c.memberBegin; i < c.memberEnd; ++i) {
+        const Vpl& v = s.vpls[sc.members[i]];
+        const glm::vec3 d = v.position - s.vpls[c.representative].position;
+        spread2 += double(v.power()) * glm::dot(d, d);
+        power += v.power();
+      }
+      EXPECT_NEAR(c.spread, std::sqrt(spread2 / power), 1e-4 * (1.0 + std::sqrt(spread2 / power)));
     }
     for (int count : seen) ASSERT_EQ(count, 1);
     for (int k = 0; k < 3; ++k) EXPECT_NEAR(sum[k], total[k], 1e-4 * total[k]);
@@ -197,6 +206,7 @@ TEST(LightSlice, BudgetAtLeastVplCountGivesSingletons) {
     double clustered = 0.0, exact = 0.0;
     for (const VplCluster& c : sc.clusters) {
       ASSERT_EQ(c.memberEnd - c.memberBegin, 1u);
+      ASSERT_EQ(c.spread, 0.0f);
       clustered += c.estimate;
     }
     for (uint32_t v = 0; v < s.vpls.size(); ++v) exact += transport.contribution(uint32_t(slice), v, true);

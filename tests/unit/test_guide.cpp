@@ -30,16 +30,25 @@ struct Case {
   size_t reps;
   float coneDegrees;
   bool clustered;
+  float widestRepDegrees = 0.0f;  // > 0: each representative asks for its own cone up to this wide
 };
 
 std::vector<Case> cases() {
   return {{"one wide", 1, 30, false},  {"one narrow", 1, 3, false},    {"few wide", 5, 30, true},
-          {"few narrow", 5, 3, true},  {"many wide", 500, 30, false},  {"many narrow", 500, 3, true}};
+          {"few narrow", 5, 3, true},  {"many wide", 500, 30, false},  {"many narrow", 500, 3, true},
+          {"near clusters", 20, 3, true, 90.0f}};
+}
+
+GuideDistribution makeDistribution(const Case& c, uint64_t seed) {
+  std::vector<GuideRepresentative> reps = randomReps(c.reps, seed, c.clustered);
+  Rng rng(seed ^ 0xc0e5ull);
+  for (GuideRepresentative& r : reps) r.coneAngle = rng.uniform() * c.widestRepDegrees * kDeg;
+  return GuideDistribution(reps, c.coneDegrees * kDeg, 0.01f);
 }
 
 TEST(GuideDistribution, PdfIntegratesToOneAndMatchesTheTarget) {
   for (const Case& c : cases()) {
-    const GuideDistribution d(randomReps(c.reps, 1, c.clustered), c.coneDegrees * kDeg, 0.01f);
+    const GuideDistribution d = makeDistribution(c, 1);
     const double integral = test::integrateSphere([&](const glm::vec3& w) { return double(d.pdf(w)); }, 1024, 2048);
     EXPECT_NEAR(integral, 1.0, c.coneDegrees < 10 ? 0.03 : 0.005) << c.name;
     Rng rng(2);
@@ -93,6 +102,13 @@ TEST(GuideDistribution, TargetIsTheConeAverageAtCellCentres) {
   const double expected = 3.0 / (double(cells.size()) * GuideDistribution::kCellSolidAngle);
   for (uint32_t c : cells) ASSERT_NEAR(d.target(GuideDistribution::cellCentre(int(c))), expected, 1e-5 * expected);
   EXPECT_EQ(d.target(-dir), 0.0f);
+  // A representative asking for a wider cone spreads the same weight over more cells.
+  const GuideDistribution wide({{dir, 3.0f, 60.0f * kDeg}}, 20.0f * kDeg, 0.01f);
+  cells.clear();
+  GuideDistribution::coneCellsLinear(dir, std::cos(60.0f * kDeg), cells);
+  const double wideExpected = 3.0 / (double(cells.size()) * GuideDistribution::kCellSolidAngle);
+  for (uint32_t c : cells) ASSERT_NEAR(wide.target(GuideDistribution::cellCentre(int(c))), wideExpected, 1e-5 * wideExpected);
+  EXPECT_NEAR(wide.totalWeight(), 3.0, 1e-6);
 }
 
 TEST(GuideDistribution, ZeroWeightIsUniform) {
@@ -106,7 +122,7 @@ TEST(GuideDistribution, ZeroWeightIsUniform) {
 
 TEST(GuideDistribution, ExactSamplerMatchesPdf) {
   for (const Case& c : cases()) {
-    const GuideDistribution d(randomReps(c.reps, 6, c.clustered), c.coneDegrees * kDeg, 0.01f);
+    const GuideDistribution d = makeDistribution(c, 6);
     Rng rng(7);
     const auto r = test::chiSquareEqualArea([&] { return d.sample(rng); }, [&](const glm::vec3& w) { return double(d.pdf(w)); },
                                             200000, 2 * GuideDistribution::kResolution);
@@ -119,7 +135,7 @@ TEST(Metropolis, IndependentChainsAreDistributedByThePdf) {
   // stationary density, which must be the pdf.
   GuideSettings settings;
   for (const Case& c : cases()) {
-    const GuideDistribution d(randomReps(c.reps, 8, c.clustered), c.coneDegrees * kDeg, 0.01f);
+    const GuideDistribution d = makeDistribution(c, 8);
     Rng rng(9);
     ChainStats stats;
     auto sample = [&] {
