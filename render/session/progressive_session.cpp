@@ -1,0 +1,298 @@
+#include "render/session/progressive_session.h"
+
+#include <chrono>
+#include <map>
+#include <tbb/info.h>
+#include <tbb/task_arena.h>
+#include "render/film/film.h"
+#include "render/guide/guide_builder.h"
+#include "render/integrator/guided_continuation.h"
+#include "render/session/tile_renderer.h"
+
+namespace vpl {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+// The quick stage renders at this fraction of the size, and keeps refining it until the camera has
+// been still this long: only then does the (not cancellable) clustering start.
+constexpr int kQuickDivisor = 4;
+constexpr double kStillSeconds = 0.15;
+
+Image upscaleNearest(const Image& small, int width, int height) {
+  Image out(width, height);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x)
+      out.at(x, y) = small.at(std::min(small.width - 1, x * small.width / width), std::min(small.height - 1, y * small.height / height));
+  return out;
+}
+
+bool isGuided(SamplingMode m) { return m == SamplingMode::Metropolis || m == SamplingMode::Mis || m == SamplingMode::Mixture; }
+
+}  // namespace
+
+const char* stageName(SessionStage stage) {
+  switch (stage) {
+    case SessionStage::Quick: return "quick";
+    case SessionStage::Preview: return "preview";
+    case SessionStage::Refine: return "refine";
+    case SessionStage::Done: return "done";
+  }
+  return "?";
+}
+
+struct ProgressiveSession::Request {
+  CameraData camera;
+  SamplingMode mode;
+  int width, height;
+};
+
+// What the controller keeps for one camera and size; dropped when either changes.
+struct ProgressiveSession::CameraState {
+  struct ModeFilm {
+    std::unique_ptr<Film> film;
+    uint64_t nextPass = 0;  // passes started (a cancelled pass still used its index)
+    int complete = 0;
+  };
+  std::optional<Request> key;
+  Clock::time_point restart = Clock::now();
+  std::unique_ptr<Film> quick;
+  uint64_t quickPasses = 0;
+  std::unique_ptr<VplField> field;
+  ModeFilm preview;
+  std::unique_ptr<GuideField> guide;
+  std::map<SamplingMode, ModeFilm> films;
+  uint64_t samples = 0, rays = 0;
+  double renderSeconds = 0.0;
+};
+
+ProgressiveSession::ProgressiveSession(std::shared_ptr<const RenderScene> scene, const CameraData& camera,
+                                       const SessionSettings& settings)
+    : scene_(std::move(scene)), settings_(settings), tracer_(*scene_, settings.tracer), camera_(camera) {
+  stats_.mode = settings.mode;
+  pending_ = std::make_unique<Request>(Request{camera, settings.mode, settings.width, settings.height});
+  controller_ = std::thread([this] { controllerLoop(); });
+}
+
+ProgressiveSession::~ProgressiveSession() {
+  {
+    std::lock_guard lock(mutex_);
+    quit_ = true;
+    cancel_.store(true);
+  }
+  changed_.notify_all();
+  controller_.join();
+}
+
+void ProgressiveSession::setCamera(const CameraData& camera) {
+  std::lock_guard lock(mutex_);
+  camera_ = camera;
+  Request r = pending_ ? *pending_ : Request{camera, stats_.mode, settings_.width, settings_.height};
+  r.camera = camera;
+  pending_ = std::make_unique<Request>(r);
+  cancel_.store(true);
+  changed_.notify_all();
+}
+
+void ProgressiveSession::setMode(SamplingMode mode) {
+  std::lock_guard lock(mutex_);
+  Request r = pending_ ? *pending_ : Request{camera_, stats_.mode, settings_.width, settings_.height};
+  r.mode = mode;
+  stats_.mode = mode;
+  pending_ = std::make_unique<Request>(r);
+  cancel_.store(true);
+  changed_.notify_all();
+}
+
+void ProgressiveSession::resize(int width, int height) {
+  if (width < 1 || height < 1) return;
+  std::lock_guard lock(mutex_);
+  if (width == settings_.width && height == settings_.height) return;
+  settings_.width = width;
+  settings_.height = height;
+  Request r = pending_ ? *pending_ : Request{camera_, stats_.mode, width, height};
+  r.width = width;
+  r.height = height;
+  pending_ = std::make_unique<Request>(r);
+  cancel_.store(true);
+  changed_.notify_all();
+}
+
+bool ProgressiveSession::latestImage(Image& out, uint64_t& version) const {
+  std::lock_guard lock(mutex_);
+  if (version_ == version) return false;
+  out = shown_;
+  version = version_;
+  return true;
+}
+
+SessionStats ProgressiveSession::stats() const {
+  std::lock_guard lock(mutex_);
+  return stats_;
+}
+
+CameraData ProgressiveSession::camera() const {
+  std::lock_guard lock(mutex_);
+  return camera_;
+}
+
+bool ProgressiveSession::waitUntilDone(double seconds) const {
+  std::unique_lock lock(mutex_);
+  return changed_.wait_for(lock, std::chrono::duration<double>(seconds), [this] { return idle_ && !pending_; });
+}
+
+void ProgressiveSession::publish(const Image& image, SessionStage stage, int spp) {
+  std::lock_guard lock(mutex_);
+  shown_ = image;
+  ++version_;
+  stats_.stage = stage;
+  stats_.spp = spp;
+}
+
+void ProgressiveSession::controllerLoop() {
+  const int threads = settings_.threads > 0 ? settings_.threads : tbb::info::default_concurrency();
+  tbb::task_arena arena(threads);
+  CameraState state;
+  for (;;) {
+    Request request;
+    {
+      std::unique_lock lock(mutex_);
+      changed_.wait(lock, [this] { return quit_ || pending_ != nullptr; });
+      if (quit_) return;
+      request = *pending_;
+      pending_.reset();
+      idle_ = false;
+      cancel_.store(false);
+    }
+    const bool sameView = state.key && state.key->width == request.width && state.key->height == request.height &&
+                          state.key->camera.eye == request.camera.eye && state.key->camera.target == request.camera.target &&
+                          state.key->camera.up == request.camera.up && state.key->camera.yfov == request.camera.yfov;
+    if (!sameView) {
+      const uint64_t samples = state.samples, rays = state.rays;
+      const double seconds = state.renderSeconds;
+      state = CameraState();
+      state.samples = samples;  // rates are per session, not per view
+      state.rays = rays;
+      state.renderSeconds = seconds;
+      std::lock_guard lock(mutex_);
+      ++stats_.restarts;
+    }
+    state.key = request;
+    arena.execute([&] { runUntilChanged(state, request); });
+    std::lock_guard lock(mutex_);
+    if (!cancelled() && !pending_) {
+      idle_ = true;
+      stats_.stage = SessionStage::Done;
+      changed_.notify_all();
+    }
+  }
+}
+
+void ProgressiveSession::runUntilChanged(CameraState& state, const Request& request) {
+  const RenderScene& scene = *scene_;
+  const int w = request.width, h = request.height;
+  auto noteTime = [&] {
+    std::lock_guard lock(mutex_);
+    stats_.sinceRestart = secondsSince(state.restart);
+  };
+
+  // 1. Quick: quarter-size BSDF passes until the camera has been still for a moment.
+  if (!state.field) {
+    const Camera small(request.camera, std::max(1, w / kQuickDivisor), std::max(1, h / kQuickDivisor));
+    if (!state.quick) state.quick = std::make_unique<Film>(small.width(), small.height());
+    const TileRenderer renderer(small, settings_.seed, pathTracerShader(tracer_));
+    do {
+      // The first quick pass always completes: a restart never leaves the window without a frame.
+      const uint64_t pass = state.quickPasses++;
+      renderer.renderPass(*state.quick, pass, pass > 0 ? &cancel_ : nullptr);
+      if (cancelled()) return;
+      publish(upscaleNearest(state.quick->resolve(), w, h), SessionStage::Quick, int(state.quickPasses));
+      if (state.quickPasses == 1) {
+        std::lock_guard lock(mutex_);
+        stats_.firstFrameSeconds = secondsSince(state.restart);
+      }
+      noteTime();
+    } while (secondsSince(state.restart) < kStillSeconds);
+  }
+
+  // 2. Preview: VPLs once per scene, this view's slices and clusters, a few preview passes.
+  const Camera camera(request.camera, w, h);
+  if (!state.field) {
+    auto t = Clock::now();
+    if (!vpls_) {
+      VplSettings vplSettings = settings_.preview.vpl;
+      vplSettings.seed = settings_.seed;
+      vpls_ = std::make_shared<const VplSet>(traceVpls(scene, vplSettings));
+    }
+    const double vplSeconds = secondsSince(t);
+    t = Clock::now();
+    PreviewSettings preview = settings_.preview;
+    preview.clustering.seed = settings_.seed;
+    state.field = std::make_unique<VplField>(buildVplField(scene, camera, vpls_, preview));
+    std::lock_guard lock(mutex_);
+    stats_.vplSeconds = vplSeconds;
+    stats_.clusterSeconds = secondsSince(t);
+    stats_.vpls = vpls_->vpls.size();
+  }
+  if (cancelled()) return;
+  const PixelShaderFactory previewShading = previewShader(scene, *state.field, settings_.preview);
+  const int previewTarget = request.mode == SamplingMode::Preview ? settings_.maxSpp : settings_.previewPasses;
+  CameraState::ModeFilm& preview = state.preview;
+  if (!preview.film) preview.film = std::make_unique<Film>(w, h);
+  const TileRenderer previewRenderer(camera, settings_.seed, previewShading);
+  auto modeFilmComplete = [&] {
+    auto it = state.films.find(request.mode);
+    return it == state.films.end() ? 0 : it->second.complete;
+  };
+  while (preview.complete < previewTarget && modeFilmComplete() < settings_.handoverSpp) {
+    previewRenderer.renderPass(*preview.film, preview.nextPass++, &cancel_);
+    if (cancelled()) return;
+    ++preview.complete;
+    publish(preview.film->resolve(), SessionStage::Preview, preview.complete);
+    noteTime();
+  }
+  if (request.mode == SamplingMode::Preview) return;
+
+  // 3. Refine: the guide for guided modes, then path-traced passes into this mode's film.
+  if (isGuided(request.mode) && !state.guide) {
+    const auto t = Clock::now();
+    state.guide = std::make_unique<GuideField>(buildGuideField(scene, *state.field, settings_.guide));
+    std::lock_guard lock(mutex_);
+    stats_.guideSeconds = secondsSince(t);
+    stats_.cachePoints = state.guide->size();
+  }
+  if (cancelled()) return;
+  CameraState::ModeFilm& mine = state.films[request.mode];
+  if (!mine.film) mine.film = std::make_unique<Film>(w, h);
+  ContinuationFactory continuation;
+  if (isGuided(request.mode)) {
+    const GuideField& guide = *state.guide;
+    const SamplingMode mode = request.mode;
+    continuation = [&guide, mode](uint32_t, uint64_t) { return std::make_unique<GuidedContinuation>(guide, mode); };
+  }
+  const TileRenderer renderer(camera, settings_.seed, pathTracerShader(tracer_, continuation));
+  // A mode flipped back to shows its own film at once, if it has passed the handover.
+  if (mine.complete >= settings_.handoverSpp) publish(mine.film->resolve(), SessionStage::Refine, mine.complete);
+  while (mine.complete < settings_.maxSpp) {
+    const auto t = Clock::now();
+    const PassStats pass = renderer.renderPass(*mine.film, mine.nextPass++, &cancel_);
+    state.renderSeconds += secondsSince(t);
+    state.samples += pass.samples;
+    state.rays += pass.rays;
+    {
+      std::lock_guard lock(mutex_);
+      stats_.discarded += pass.discarded;
+      stats_.samplesPerSecond = state.renderSeconds > 0 ? double(state.samples) / state.renderSeconds : 0.0;
+      stats_.raysPerSecond = state.renderSeconds > 0 ? double(state.rays) / state.renderSeconds : 0.0;
+    }
+    if (cancelled()) return;
+    ++mine.complete;
+    if (mine.complete >= settings_.handoverSpp || preview.complete == 0)
+      publish(mine.film->resolve(), SessionStage::Refine, mine.complete);
+    noteTime();
+  }
+}
+
+}  // namespace vpl

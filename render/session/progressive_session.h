@@ -1,0 +1,107 @@
+// The progressive render loop the viewer drives (DESIGN.md §2 step 9). One controller thread runs
+// the passes on a TBB arena of `threads` workers; the UI thread only posts changes (camera, mode,
+// size) and picks up the newest image, so it never waits for a pass. After every restart:
+//   1. quick     a 1-spp BSDF pass at a quarter of the resolution: a whole new frame at once
+//   2. preview   this camera's gather points, slices and LightSlice clusters (the VPLs themselves are
+//                traced once per scene and kept), then `previewPasses` preview passes
+//   3. refine    the guide (guided modes), then path-traced passes into the mode's own film, until
+//                `maxSpp`
+// The shown image is the newest stage with something to show; the path-traced film takes over once
+// it has `handoverSpp` samples, so the picture is never black and never steps back. Films are kept
+// per mode while the camera stays, so flipping back to a mode shows its image at once.
+#pragma once
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include "render/film/image.h"
+#include "render/guide/guide_settings.h"
+#include "render/integrator/path_tracer.h"
+#include "render/integrator/sampling_mode.h"
+#include "render/scene/camera.h"
+#include "render/scene/render_scene.h"
+#include "render/vpl/vpl_preview.h"
+
+namespace vpl {
+
+struct SessionSettings {
+  SamplingMode mode = SamplingMode::Mis;
+  int width = 640, height = 480;
+  uint64_t seed = 1;
+  int threads = 0;           // render workers; 0: every core
+  int previewPasses = 8;
+  int handoverSpp = 8;       // path-traced samples before the display leaves the preview
+  int maxSpp = 1 << 16;      // the controller idles after this many path-traced samples
+  PathTracerSettings tracer;
+  PreviewSettings preview;
+  GuideSettings guide;
+};
+
+enum class SessionStage { Quick, Preview, Refine, Done };
+const char* stageName(SessionStage stage);
+
+struct SessionStats {
+  SessionStage stage = SessionStage::Quick;  // of the image shown
+  SamplingMode mode = SamplingMode::Mis;
+  int spp = 0;                   // samples per pixel of the image shown (preview: passes)
+  double sinceRestart = 0.0;     // seconds since the last restart
+  double firstFrameSeconds = 0.0;  // restart -> first full frame (the quick pass)
+  double samplesPerSecond = 0.0, raysPerSecond = 0.0;  // of the path-traced passes so far
+  double vplSeconds = 0.0, clusterSeconds = 0.0, guideSeconds = 0.0;
+  size_t vpls = 0, cachePoints = 0;
+  uint64_t discarded = 0;
+  uint64_t restarts = 0;
+};
+
+class ProgressiveSession {
+ public:
+  ProgressiveSession(std::shared_ptr<const RenderScene> scene, const CameraData& camera, const SessionSettings& settings);
+  ~ProgressiveSession();  // cancels the pass under way and joins every thread
+  ProgressiveSession(const ProgressiveSession&) = delete;
+  ProgressiveSession& operator=(const ProgressiveSession&) = delete;
+
+  // Each of these cancels the pass under way; the controller restarts at once.
+  void setCamera(const CameraData& camera);
+  void setMode(SamplingMode mode);
+  void resize(int width, int height);  // sizes below 1 are ignored (a minimised window)
+
+  // Copies the newest image into `out` when it is newer than `version` (then updated); else false.
+  bool latestImage(Image& out, uint64_t& version) const;
+  SessionStats stats() const;
+  const SessionSettings& settings() const { return settings_; }
+  CameraData camera() const;
+  // Blocks until the controller is idle (maxSpp reached) or `seconds` pass; true when idle. For tests
+  // and scripted captures.
+  bool waitUntilDone(double seconds) const;
+
+ private:
+  struct Request;
+  struct CameraState;
+  void controllerLoop();
+  void runUntilChanged(CameraState& state, const Request& request);
+  void publish(const Image& image, SessionStage stage, int spp);
+  bool cancelled() const { return cancel_.load(std::memory_order_relaxed); }
+
+  std::shared_ptr<const RenderScene> scene_;
+  SessionSettings settings_;  // width and height change under mutex_; the rest is fixed
+  PathTracer tracer_;
+  std::shared_ptr<const VplSet> vpls_;  // traced once per scene; only the controller touches it
+
+  mutable std::mutex mutex_;  // guards everything below up to the thread
+  mutable std::condition_variable changed_;
+  std::unique_ptr<Request> pending_;
+  bool quit_ = false, idle_ = false;
+  Image shown_;
+  uint64_t version_ = 0;
+  SessionStats stats_;
+  CameraData camera_;
+
+  std::atomic<bool> cancel_{false};
+  std::thread controller_;
+};
+
+}  // namespace vpl
