@@ -12,13 +12,19 @@
 #include "render/session/render_job.h"
 #include "render/session/ray_benchmark.h"
 #include "app/render_options.h"
+#include "ui/osmesa_capture.h"
+#include "ui/viewer.h"
 
 namespace vpl::app {
 
 namespace {
 
-RenderOptions gRender, gBench;
+RenderOptions gRender, gBench, gCapture;
 CLI::App* gRenderCommand = nullptr;
+CLI::App* gCaptureCommand = nullptr;
+RenderOptions gViewer;  // the viewer reuses the mode, size, seed, thread, exposure and VPL/guide flags
+std::string gScreenshot, gStatsLog;
+double gScreenshotAfter = 3.0;
 CLI::App* gBenchCommand = nullptr;
 CLI::App* gCompareCommand = nullptr;
 std::string gCompareImage, gCompareReference, gCompareMap;
@@ -89,6 +95,44 @@ int runBench() {
   return 0;
 }
 
+int runCapture() {
+  RenderJobSettings settings = gCapture.toSettings();
+  tbb::global_control threads(tbb::global_control::max_allowed_parallelism, gCapture.threadCount());
+  checkWritable(gCapture.out);
+  ProgressBar bar("capture", isatty(STDERR_FILENO) != 0);
+  const RenderJobResult result = runRenderJob(settings, [&](double f) { bar.update(f, ""); });
+  bar.finish();
+  for (const std::string& notice : result.notices) std::fprintf(stderr, "vplview: note: %s\n", notice.c_str());
+  // Through the viewer's own display code, in a software OpenGL context.
+  writePngBytes(gCapture.out, result.image.width, result.image.height,
+                ui::captureThroughDisplay(result.image, gCapture.exposure));
+  nlohmann::ordered_json j = summaryJson(settings, result);
+  j["capture"] = gCapture.out;
+  std::printf("%s\n", j.dump().c_str());
+  return 0;
+}
+
+int runViewerCommand() {
+  ui::ViewerOptions options;
+  options.scenePath = gViewer.scene.empty() ? std::string(VPLVIEW_DEFAULT_SCENE) : gViewer.scene;
+  const RenderJobSettings s = gViewer.toSettings();
+  options.session.mode = s.mode;
+  options.session.seed = s.seed;
+  options.session.threads = gViewer.threads;
+  options.session.tracer = s.tracer;
+  options.session.preview = s.preview;
+  options.session.guide = s.guide;
+  options.sky = s.sky;
+  options.windowWidth = gViewer.width;
+  options.windowHeight = gViewer.height;
+  options.exposure = gViewer.exposure;
+  options.screenshot = gScreenshot;
+  options.screenshotAfter = gScreenshotAfter;
+  options.statsLog = gStatsLog;
+  if (!gScreenshot.empty()) checkWritable(gScreenshot);
+  return ui::runViewer(options);
+}
+
 int runCompare() {
   const Image image = readExr(gCompareImage), reference = readExr(gCompareReference);
   nlohmann::ordered_json j;
@@ -111,6 +155,19 @@ void registerCommands(CLI::App& app) {
   gRenderCommand = app.add_subcommand("render", "render a scene headlessly to EXR (and PNG)");
   gRender.addTo(*gRenderCommand, /*requireOut=*/true);
 
+  gCaptureCommand = app.add_subcommand("capture", "render headlessly and save what the viewer's display would show (OSMesa)");
+  gCapture.addTo(*gCaptureCommand, /*requireOut=*/true);
+
+  // No subcommand: the viewer, on SCENE or the built-in Cornell box.
+  gViewer.mode = "mis";
+  gViewer.width = 1280;
+  gViewer.height = 720;
+  gViewer.addViewerOptionsTo(app);
+  app.add_option("--screenshot", gScreenshot, "viewer: save what the window shows as PNG, then exit");
+  app.add_option("--screenshot-after", gScreenshotAfter, "viewer: seconds of rendering before --screenshot")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--stats-log", gStatsLog, "viewer: write frame rate and session figures once a second to this file");
+
   gBenchCommand = app.add_subcommand("bench", "path tracer rays/s against the raw Embree rate on the same scene");
   gBench.addTo(*gBenchCommand, /*requireOut=*/false);
   gBenchCommand->add_option("--raw-seconds", gBench.rawSeconds, "seconds of raw incoherent rtcIntersect1 rays")
@@ -127,9 +184,9 @@ int runSelectedCommand(CLI::App& app) {
   if (gCompareCommand->parsed()) return runCompare();
   if (gRenderCommand->parsed()) return runRender();
   if (gBenchCommand->parsed()) return runBench();
-  std::fprintf(stderr, "vplview: the viewer is not built yet; use 'vplview render SCENE --out X.exr' (see --help)\n");
+  if (gCaptureCommand->parsed()) return runCapture();
   (void)app;
-  return 2;
+  return runViewerCommand();
 }
 
 }  // namespace vpl::app

@@ -31,12 +31,24 @@ glm::vec3 parseSky(const std::string& text) {
 
 void RenderOptions::addTo(CLI::App& command, bool requireOut) {
   command.add_option("scene", scene, "glTF 2.0 scene (.gltf or .glb)")->required();
-  command.add_option("--mode", mode, "brdf | metropolis | mis | mixture | preview")
-      ->check(CLI::IsMember({"brdf", "metropolis", "mis", "mixture", "preview"}));
   auto* sppOpt = command.add_option("--spp", spp, "samples per pixel")->check(CLI::PositiveNumber);
   auto* timeOpt = command.add_option("--time", time, "seconds after loading (preprocessing included)")
                       ->check(CLI::PositiveNumber);
   sppOpt->excludes(timeOpt);
+  addCommonTo(command);
+  auto* outOpt = command.add_option("--out", out, "output image (render: OpenEXR, linear RGB float; capture: PNG)");
+  if (requireOut) outOpt->required();
+  command.add_option("--png", png, "also write an sRGB PNG");
+}
+
+void RenderOptions::addViewerOptionsTo(CLI::App& app) {
+  app.add_option("scene", scene, "glTF 2.0 scene to open (default: the built-in Cornell box)");
+  addCommonTo(app);
+}
+
+void RenderOptions::addCommonTo(CLI::App& command) {
+  command.add_option("--mode", mode, "brdf | metropolis | mis | mixture | preview")
+      ->check(CLI::IsMember({"brdf", "metropolis", "mis", "mixture", "preview"}));
   command.add_option("--width", width, "image width in pixels")->check(CLI::Range(1, 16384));
   command.add_option("--height", height, "image height in pixels")->check(CLI::Range(1, 16384));
   command.add_option("--seed", seed, "random seed (same seed, same image)");
@@ -44,9 +56,6 @@ void RenderOptions::addTo(CLI::App& command, bool requireOut) {
   command.add_option("--max-depth", maxDepth, "maximum path length in segments (1: direct light only)")
       ->check(CLI::Range(1, 1024));
   command.add_option("--sky", sky, "uniform sky radiance R,G,B; 0 turns it off (default: on only without lights)");
-  auto* outOpt = command.add_option("--out", out, "output OpenEXR image (linear RGB float)");
-  if (requireOut) outOpt->required();
-  command.add_option("--png", png, "also write an sRGB PNG");
   command.add_option("--exposure", exposure, "PNG exposure in stops");
   command.add_option("--vpls", preview.vpl.count, "number of VPLs")->check(CLI::Range(0, 50'000'000));
   command.add_option("--slice-size", preview.slices.maxSliceSize, "largest slice, in gather points")->check(CLI::Range(1, 1 << 24));

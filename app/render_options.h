@@ -23,10 +23,14 @@ struct RenderOptions {
   GuideSettings guide;
   float coneDegrees = 20.4f, perturbDegrees = 9.0f;
 
-  void addTo(CLI::App& command, bool requireOut);
+  void addTo(CLI::App& command, bool requireOut);  // a headless command: scene, budget, outputs, the rest
+  void addViewerOptionsTo(CLI::App& app);           // the viewer: an optional scene and the rest
   // Checked conversion; throws InputError for values CLI11 cannot check alone.
   RenderJobSettings toSettings() const;
   int threadCount() const;
+
+ private:
+  void addCommonTo(CLI::App& command);  // mode, size, seed, threads, depth, sky, exposure, VPL and guide flags
 };
 
 // Throws InputError when a file cannot be created at path (missing folder, no permission).

@@ -93,9 +93,14 @@ size_t writePng(const std::string& path, const Image& image, float exposureStops
       bad += !std::isfinite(v);
       bytes[3 * i + c] = toDisplayByte(std::isfinite(v) ? v : 0.0f, exposureStops);
     }
-  if (!stbi_write_png(path.c_str(), image.width, image.height, 3, bytes.data(), image.width * 3))
-    throw InputError(path + ": cannot write PNG");
+  writePngBytes(path, image.width, image.height, bytes);
   return bad;
+}
+
+void writePngBytes(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb) {
+  if (width <= 0 || height <= 0 || rgb.size() != size_t(width) * size_t(height) * 3)
+    throw InputError(path + ": cannot write an empty or mis-sized image");
+  if (!stbi_write_png(path.c_str(), width, height, 3, rgb.data(), width * 3)) throw InputError(path + ": cannot write PNG");
 }
 
 Image readPng(const std::string& path) {

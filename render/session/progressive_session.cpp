@@ -230,6 +230,9 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
     t = Clock::now();
     PreviewSettings preview = settings_.preview;
     preview.clustering.seed = settings_.seed;
+    // LightSlice's cost grows with the slice count: a large window gets larger slices, not more.
+    if (settings_.maxSlices > 0)
+      preview.slices.maxSliceSize = std::max(preview.slices.maxSliceSize, (w * h + settings_.maxSlices - 1) / settings_.maxSlices);
     state.field = std::make_unique<VplField>(buildVplField(scene, camera, vpls_, preview));
     std::lock_guard lock(mutex_);
     stats_.vplSeconds = vplSeconds;

@@ -36,6 +36,7 @@ struct SessionSettings {
   int previewPasses = 8;
   int handoverSpp = 8;       // path-traced samples before the display leaves the preview
   int maxSpp = 1 << 16;      // the controller idles after this many path-traced samples
+  int maxSlices = 384;       // slices (cache points) per view at most; 0: preview.slices alone decides
   PathTracerSettings tracer;
   PreviewSettings preview;
   GuideSettings guide;

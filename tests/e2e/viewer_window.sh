@@ -1,0 +1,20 @@
+#!/usr/bin/env bash
+# Windowed smoke test: the viewer opens the Cornell box in a real window on a virtual X display,
+# renders for 3 seconds, saves what the window shows and exits 0; the screenshot is not black and
+# matches the headless capture of the same view (block means: the window may still show the
+# preview, which is slightly darker than the converged image).
+# Usage (CTest): viewer_window.sh PATH/TO/vplview REPO_ROOT. Exit 77 (skip) without xvfb-run.
+set -u
+exe=$1; repo=$2
+command -v xvfb-run >/dev/null || { echo "SKIP: xvfb-run is missing (scripts/setup.sh installs xvfb)"; exit 77; }
+tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+scene=$repo/scenes/cornell_box.gltf
+timeout 120 xvfb-run -a -s "-screen 0 640x480x24" "$exe" "$scene" --width 320 --height 240 --threads 2 \
+    --screenshot "$tmp/window.png" --screenshot-after 3 --stats-log "$tmp/stats.txt"
+rc=$?
+cat "$tmp/stats.txt" 2>/dev/null
+[ $rc = 0 ] || { echo "FAIL: the viewer exited with $rc"; exit 1; }
+[ -s "$tmp/window.png" ] || { echo "FAIL: no screenshot"; exit 1; }
+"$exe" capture "$scene" --mode brdf --spp 256 --width 320 --height 240 --out "$tmp/capture.png" >/dev/null || exit 1
+python3 "$repo/tests/e2e/png_compare.py" "$tmp/window.png" "$tmp/capture.png" 6 25 10 || exit 1
+echo "ok: window screenshot matches the headless capture"

@@ -1,0 +1,261 @@
+#include "ui/viewer.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <stdexcept>
+#define GLFW_INCLUDE_NONE  // the display loads its own GL entry points (ui/gl_api.h)
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl3.h>
+#include "render/film/image_io.h"
+#include "render/scene/camera.h"
+#include "render/scene/gltf_loader.h"
+#include "ui/camera_controller.h"
+#include "ui/display_pipeline.h"
+
+namespace vpl::ui {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+constexpr double kFrameSeconds = 1.0 / 60.0;
+
+constexpr SamplingMode kModes[] = {SamplingMode::Brdf, SamplingMode::Metropolis, SamplingMode::Mis, SamplingMode::Mixture,
+                                   SamplingMode::Preview};
+
+// Window-system state the GLFW callbacks reach through the user pointer.
+struct InputState {
+  double scroll = 0.0;
+};
+
+class GlfwLibrary {
+ public:
+  GlfwLibrary() {
+    glfwSetErrorCallback([](int, const char* text) { std::fprintf(stderr, "vplview: GLFW: %s\n", text); });
+    ok_ = glfwInit() == GLFW_TRUE;
+  }
+  ~GlfwLibrary() {
+    if (ok_) glfwTerminate();
+  }
+  bool ok() const { return ok_; }
+
+ private:
+  bool ok_ = false;
+};
+
+// The panel's editable copy of the settings that need a new session when applied.
+struct PanelSettings {
+  int vpls;
+  int clusters;
+  float coneDegrees;
+  float bsdfProbability;
+  float defensive;
+  float uniformMutation;
+};
+
+}  // namespace
+
+int runViewer(const ViewerOptions& options) {
+  // The scene first: a file that does not load never opens a window.
+  auto scene = std::make_shared<const RenderScene>(loadGltf(options.scenePath), options.sky);
+  GlfwLibrary glfw;
+  if (!glfw.ok()) {
+    std::fprintf(stderr, "vplview: cannot open a window (no display?); use 'vplview render' or 'vplview capture'\n");
+    return 1;
+  }
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+  const std::string title = "vplview - " + options.scenePath;
+  GLFWwindow* window = glfwCreateWindow(options.windowWidth, options.windowHeight, title.c_str(), nullptr, nullptr);
+  if (!window) {
+    std::fprintf(stderr, "vplview: cannot create an OpenGL 3.3 core window\n");
+    return 1;
+  }
+  glfwMakeContextCurrent(window);
+  glfwSwapInterval(0);  // paced by the loop below
+  InputState input;
+  glfwSetWindowUserPointer(window, &input);
+  glfwSetScrollCallback(window, [](GLFWwindow* w, double, double dy) {
+    static_cast<InputState*>(glfwGetWindowUserPointer(w))->scroll += dy;
+  });
+
+  GlApi gl;
+  gl.load([](const char* name) { return reinterpret_cast<void*>(glfwGetProcAddress(name)); });
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini beside the user's files
+  ImGui_ImplGlfw_InitForOpenGL(window, true);
+  ImGui_ImplOpenGL3_Init("#version 330");
+
+  int exitStatus = 0;
+  {
+    DisplayPipeline display(gl);
+    const CameraData start = defaultCamera(scene->data());
+    CameraController controller(start, frameBounds(scene->data().boundsMin, scene->data().boundsMax, start.yfov),
+                                scene->radius());
+    SessionSettings settings = options.session;
+    glfwGetFramebufferSize(window, &settings.width, &settings.height);
+    settings.width = std::max(1, settings.width);
+    settings.height = std::max(1, settings.height);
+    auto session = std::make_unique<ProgressiveSession>(scene, start, settings);
+    PanelSettings panel{settings.preview.vpl.count, settings.preview.clustering.clusterBudget,
+                        settings.guide.coneAngle * 57.29578f, settings.guide.bsdfProbability, settings.guide.defensive,
+                        settings.guide.uniformMutation};
+
+    Image image;
+    uint64_t version = 0;
+    float exposure = options.exposure;
+    bool showPanel = true;
+    std::string message;
+    const auto opened = Clock::now();
+    auto lastFrame = Clock::now(), lastLog = Clock::now();
+    int framesSinceLog = 0;
+    std::FILE* log = options.statsLog.empty() ? nullptr : std::fopen(options.statsLog.c_str(), "w");
+    // Key presses as edges: GLFW reports states, and a held key must act once.
+    std::array<bool, GLFW_KEY_LAST + 1> wasDown{};
+    auto pressed = [&](int key) {
+      const bool down = glfwGetKey(window, key) == GLFW_PRESS, edge = down && !wasDown[size_t(key)];
+      wasDown[size_t(key)] = down;
+      return edge;
+    };
+    double lastX = 0.0, lastY = 0.0;
+    glfwGetCursorPos(window, &lastX, &lastY);
+
+    while (!glfwWindowShouldClose(window)) {
+      // Pace the UI at kFrameSeconds: it wakes for input at once, and otherwise leaves the cores to
+      // the render threads (a virtual display has no vertical sync to wait on).
+      glfwWaitEventsTimeout(std::max(0.0, kFrameSeconds - secondsSince(lastFrame)));
+      const double dt = secondsSince(lastFrame);
+      lastFrame = Clock::now();
+      ImGui_ImplOpenGL3_NewFrame();
+      ImGui_ImplGlfw_NewFrame();
+      ImGui::NewFrame();
+      const ImGuiIO& io = ImGui::GetIO();
+
+      // Navigation, unless the panel has the mouse or keyboard.
+      double x = 0.0, y = 0.0;
+      glfwGetCursorPos(window, &x, &y);
+      int fbWidth = 0, fbHeight = 0;
+      glfwGetFramebufferSize(window, &fbWidth, &fbHeight);
+      if (!io.WantCaptureMouse) {
+        const float dx = float(x - lastX), dy = float(y - lastY);
+        if (glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS) controller.orbit(dx, dy);
+        if (glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_MIDDLE) == GLFW_PRESS) controller.pan(dx, dy, fbHeight);
+        if (glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS) controller.dolly(-dy * 0.05f);
+        if (input.scroll != 0.0) controller.dolly(float(input.scroll));
+      }
+      input.scroll = 0.0;
+      lastX = x;
+      lastY = y;
+      if (!io.WantCaptureKeyboard) {
+        auto down = [&](int key) { return glfwGetKey(window, key) == GLFW_PRESS ? 1.0f : 0.0f; };
+        controller.fly({down(GLFW_KEY_D) - down(GLFW_KEY_A), down(GLFW_KEY_E) - down(GLFW_KEY_Q),
+                        down(GLFW_KEY_W) - down(GLFW_KEY_S)},
+                       float(dt));
+        if (pressed(GLFW_KEY_R)) controller.reset();
+        if (pressed(GLFW_KEY_F)) controller.frame();
+        if (pressed(GLFW_KEY_TAB)) showPanel = !showPanel;
+        if (pressed(GLFW_KEY_ESCAPE)) glfwSetWindowShouldClose(window, GLFW_TRUE);
+        for (int k = 0; k < 5; ++k)
+          if (pressed(GLFW_KEY_1 + k)) session->setMode(kModes[k]);
+      }
+      if (controller.takeChanged()) session->setCamera(controller.camera());
+      session->resize(fbWidth, fbHeight);  // ignores 0 x 0 (minimised) and unchanged sizes
+
+      if (session->latestImage(image, version)) display.upload(image);
+      const SessionStats stats = session->stats();
+
+      if (showPanel && options.screenshot.empty()) {
+        ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
+        ImGui::SetNextWindowBgAlpha(0.8f);
+        ImGui::Begin("vplview", nullptr, ImGuiWindowFlags_AlwaysAutoResize);
+        int modeIndex = 0;
+        for (int k = 0; k < 5; ++k)
+          if (kModes[k] == stats.mode) modeIndex = k;
+        const char* names[] = {"1 BRDF", "2 Metropolis", "3 MIS", "4 mixture", "5 preview"};
+        if (ImGui::Combo("mode", &modeIndex, names, 5)) session->setMode(kModes[modeIndex]);
+        ImGui::SliderFloat("exposure", &exposure, -8.0f, 8.0f, "%.1f stops");
+        ImGui::Text("%s  %d spp  %.1f s since restart", stageName(stats.stage), stats.spp, stats.sinceRestart);
+        ImGui::Text("%.3g samples/s  %.3g rays/s  first frame %.0f ms", stats.samplesPerSecond, stats.raysPerSecond,
+                    1e3 * stats.firstFrameSeconds);
+        ImGui::Text("VPLs %zu (%.2f s)  clusters %.2f s  guide %.2f s  cache points %zu", stats.vpls, stats.vplSeconds,
+                    stats.clusterSeconds, stats.guideSeconds, stats.cachePoints);
+        ImGui::Text("UI %.0f fps  discarded samples %llu", io.Framerate, static_cast<unsigned long long>(stats.discarded));
+        if (ImGui::CollapsingHeader("VPLs and guide")) {
+          ImGui::InputInt("VPLs", &panel.vpls, 1024, 8192);
+          ImGui::InputInt("clusters per slice", &panel.clusters, 10, 100);
+          ImGui::SliderFloat("cone (deg)", &panel.coneDegrees, 1.0f, 90.0f);
+          ImGui::SliderFloat("MIS BSDF probability", &panel.bsdfProbability, 0.0f, 1.0f);
+          ImGui::SliderFloat("defensive", &panel.defensive, 0.001f, 1.0f);
+          ImGui::SliderFloat("uniform mutation", &panel.uniformMutation, 0.0f, 1.0f);
+          if (ImGui::Button("apply (restarts)")) {
+            SessionSettings next = settings;
+            next.mode = stats.mode;
+            next.width = std::max(1, fbWidth);
+            next.height = std::max(1, fbHeight);
+            next.preview.vpl.count = std::clamp(panel.vpls, 0, 10'000'000);
+            next.preview.clustering.clusterBudget = std::clamp(panel.clusters, 1, 1 << 16);
+            next.guide.coneAngle = std::clamp(panel.coneDegrees, 1.0f, 90.0f) / 57.29578f;
+            next.guide.bsdfProbability = std::clamp(panel.bsdfProbability, 0.0f, 1.0f);
+            next.guide.defensive = std::clamp(panel.defensive, 0.001f, 1.0f);
+            next.guide.uniformMutation = std::clamp(panel.uniformMutation, 0.0f, 1.0f);
+            session.reset();  // joins the old controller before the new one starts
+            session = std::make_unique<ProgressiveSession>(scene, controller.camera(), next);
+            settings = next;
+            version = 0;
+          }
+        }
+        if (ImGui::Button("screenshot PNG")) {
+          writePngBytes("vplview_screenshot.png", fbWidth, fbHeight, display.readPixels(fbWidth, fbHeight));
+          message = "saved vplview_screenshot.png";
+        }
+        ImGui::SameLine();
+        if (ImGui::Button("save EXR") && image.width > 0) {
+          writeExr("vplview_image.exr", image);
+          message = "saved vplview_image.exr";
+        }
+        if (!message.empty()) ImGui::TextUnformatted(message.c_str());
+        ImGui::End();
+      }
+      ImGui::Render();
+
+      if (fbWidth > 0 && fbHeight > 0) {
+        display.draw(fbWidth, fbHeight, exposure, DisplayView::Image);
+        if (!options.screenshot.empty() && secondsSince(opened) >= options.screenshotAfter) {
+          // What the window shows, read before the panel is drawn over it.
+          writePngBytes(options.screenshot, fbWidth, fbHeight, display.readPixels(fbWidth, fbHeight));
+          glfwSetWindowShouldClose(window, GLFW_TRUE);
+        }
+        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+      }
+      glfwSwapBuffers(window);
+      ++framesSinceLog;
+      if (log && secondsSince(lastLog) >= 1.0) {
+        std::fprintf(log, "t %.2f fps %.1f stage %s spp %d first_frame_ms %.1f samples_per_s %.4g\n", secondsSince(opened),
+                     framesSinceLog / secondsSince(lastLog), stageName(stats.stage), stats.spp,
+                     1e3 * stats.firstFrameSeconds, stats.samplesPerSecond);
+        std::fflush(log);
+        framesSinceLog = 0;
+        lastLog = Clock::now();
+      }
+      if (glfwGetWindowAttrib(window, GLFW_ICONIFIED)) glfwWaitEventsTimeout(0.1);
+    }
+    if (log) std::fclose(log);
+    session.reset();  // stop rendering before the GL objects go
+  }
+  ImGui_ImplOpenGL3_Shutdown();
+  ImGui_ImplGlfw_Shutdown();
+  ImGui::DestroyContext();
+  glfwDestroyWindow(window);
+  return exitStatus;
+}
+
+}  // namespace vpl::ui
