@@ -24,6 +24,7 @@ CLI::App* gRenderCommand = nullptr;
 CLI::App* gCaptureCommand = nullptr;
 RenderOptions gViewer;  // the viewer reuses the mode, size, seed, thread, exposure and VPL/guide flags
 std::string gScreenshot, gStatsLog;
+bool gScreenshotPanel = false;
 double gScreenshotAfter = 3.0;
 CLI::App* gBenchCommand = nullptr;
 CLI::App* gCompareCommand = nullptr;
@@ -129,6 +130,7 @@ int runViewerCommand() {
   options.screenshot = gScreenshot;
   options.screenshotAfter = gScreenshotAfter;
   options.statsLog = gStatsLog;
+  options.screenshotPanel = gScreenshotPanel;
   if (!gScreenshot.empty()) checkWritable(gScreenshot);
   return ui::runViewer(options);
 }
@@ -166,6 +168,7 @@ void registerCommands(CLI::App& app) {
   app.add_option("--screenshot", gScreenshot, "viewer: save what the window shows as PNG, then exit");
   app.add_option("--screenshot-after", gScreenshotAfter, "viewer: seconds of rendering before --screenshot")
       ->check(CLI::NonNegativeNumber);
+  app.add_flag("--screenshot-panel", gScreenshotPanel, "viewer: keep the panel in the screenshot");
   app.add_option("--stats-log", gStatsLog, "viewer: write frame rate and session figures once a second to this file");
 
   gBenchCommand = app.add_subcommand("bench", "path tracer rays/s against the raw Embree rate on the same scene");

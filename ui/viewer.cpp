@@ -173,7 +173,7 @@ int runViewer(const ViewerOptions& options) {
       if (session->latestImage(image, version)) display.upload(image);
       const SessionStats stats = session->stats();
 
-      if (showPanel && options.screenshot.empty()) {
+      if (showPanel && (options.screenshot.empty() || options.screenshotPanel)) {
         ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
         ImGui::SetNextWindowBgAlpha(0.8f);
         ImGui::Begin("vplview", nullptr, ImGuiWindowFlags_AlwaysAutoResize);
@@ -229,12 +229,12 @@ int runViewer(const ViewerOptions& options) {
 
       if (fbWidth > 0 && fbHeight > 0) {
         display.draw(fbWidth, fbHeight, exposure, DisplayView::Image);
-        if (!options.screenshot.empty() && secondsSince(opened) >= options.screenshotAfter) {
-          // What the window shows, read before the panel is drawn over it.
-          writePngBytes(options.screenshot, fbWidth, fbHeight, display.readPixels(fbWidth, fbHeight));
-          glfwSetWindowShouldClose(window, GLFW_TRUE);
-        }
+        const bool shoot = !options.screenshot.empty() && secondsSince(opened) >= options.screenshotAfter;
+        // What the window shows: read before the panel is drawn over it, unless it is wanted.
+        if (shoot && !options.screenshotPanel) writePngBytes(options.screenshot, fbWidth, fbHeight, display.readPixels(fbWidth, fbHeight));
         ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+        if (shoot && options.screenshotPanel) writePngBytes(options.screenshot, fbWidth, fbHeight, display.readPixels(fbWidth, fbHeight));
+        if (shoot) glfwSetWindowShouldClose(window, GLFW_TRUE);
       }
       glfwSwapBuffers(window);
       ++framesSinceLog;

@@ -18,6 +18,7 @@ struct ViewerOptions {
   float exposure = 0.0f;
   std::string screenshot;        // when set: save what the window shows after screenshotAfter seconds, then exit
   double screenshotAfter = 3.0;
+  bool screenshotPanel = false;  // keep the panel in the screenshot (README pictures); off: the image alone
   std::string statsLog;          // when set: one line of frame and session figures per second (measurements)
 };
 

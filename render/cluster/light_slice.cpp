@@ -133,7 +133,9 @@ bool splitCluster(const Columns& cols, std::span<const Vpl> vpls, std::vector<ui
 }  // namespace
 
 LightSliceResult clusterLightSlice(std::span<const Vpl> vpls, std::span<const GatherPoint> points, const SliceTree& tree,
-                                   const LightTransport& transport, const LightSliceSettings& settings) {
+                                   const LightTransport& transport, const LightSliceSettings& settings,
+                                   const std::atomic<bool>* cancel) {
+  auto cancelled = [cancel] { return cancel && cancel->load(std::memory_order_relaxed); };
   LightSliceResult result;
   const uint32_t n = uint32_t(vpls.size()), sliceCount = uint32_t(tree.slices.size());
   result.slices.resize(sliceCount);
@@ -149,6 +151,7 @@ LightSliceResult clusterLightSlice(std::span<const Vpl> vpls, std::span<const Ga
     rowSlice[r] = std::min(sliceCount - 1, uint32_t((r + rowRng.uniform()) * stride));
   std::vector<float> matrix(size_t(rowCount) * n);
   tbb::parallel_for(uint32_t(0), rowCount * ((n + 1023) / 1024), [&](uint32_t task) {
+    if (cancelled()) return;
     const uint32_t r = task % rowCount, j0 = (task / rowCount) * 1024, j1 = std::min(n, j0 + 1024);
     for (uint32_t j = j0; j < j1; ++j) matrix[size_t(r) * n + j] = transport.contribution(rowSlice[r], j, true);
     evaluations += j1 - j0;
@@ -214,6 +217,7 @@ LightSliceResult clusterLightSlice(std::span<const Vpl> vpls, std::span<const Ga
   };
   const uint32_t k = std::min<uint32_t>(uint32_t(settings.refinementRows), rowCount);
   tbb::parallel_for(uint32_t(0), sliceCount, [&](uint32_t s) {
+    if (cancelled()) return;
     const uint32_t rep = tree.slices[s].representative;
     std::vector<std::pair<float, uint32_t>> byDistance(rowCount);
     for (uint32_t r = 0; r < rowCount; ++r) byDistance[r] = {embedDistance(rep, tree.slices[rowSlice[r]].representative), r};

@@ -10,6 +10,7 @@
 //   refinementRows  int     8     reduced rows nearest a slice used to estimate its cluster errors
 //   seed            uint64  1
 #pragma once
+#include <atomic>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -59,8 +60,10 @@ struct LightSliceResult {
   uint64_t evaluations = 0;  // contribution() calls
 };
 
+// When *cancel becomes true the remaining work is skipped: the result is then valid (every slice has
+// a possibly empty cluster list) but incomplete, and the caller discards it.
 LightSliceResult clusterLightSlice(std::span<const Vpl> vpls, std::span<const GatherPoint> points, const SliceTree& tree,
-                                   const LightTransport& transport,
-                                   const LightSliceSettings& settings);
+                                   const LightTransport& transport, const LightSliceSettings& settings,
+                                   const std::atomic<bool>* cancel = nullptr);
 
 }  // namespace vpl

@@ -233,7 +233,9 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
     // LightSlice's cost grows with the slice count: a large window gets larger slices, not more.
     if (settings_.maxSlices > 0)
       preview.slices.maxSliceSize = std::max(preview.slices.maxSliceSize, (w * h + settings_.maxSlices - 1) / settings_.maxSlices);
-    state.field = std::make_unique<VplField>(buildVplField(scene, camera, vpls_, preview));
+    auto field = std::make_unique<VplField>(buildVplField(scene, camera, vpls_, preview, &cancel_));
+    if (cancelled()) return;  // incomplete: built again when this view comes back
+    state.field = std::move(field);
     std::lock_guard lock(mutex_);
     stats_.vplSeconds = vplSeconds;
     stats_.clusterSeconds = secondsSince(t);

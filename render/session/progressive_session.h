@@ -33,8 +33,8 @@ struct SessionSettings {
   int width = 640, height = 480;
   uint64_t seed = 1;
   int threads = 0;           // render workers; 0: every core
-  int previewPasses = 8;
-  int handoverSpp = 8;       // path-traced samples before the display leaves the preview
+  int previewPasses = 4;
+  int handoverSpp = 16;      // path-traced samples before the display leaves the preview
   int maxSpp = 1 << 16;      // the controller idles after this many path-traced samples
   int maxSlices = 384;       // slices (cache points) per view at most; 0: preview.slices alone decides
   PathTracerSettings tracer;

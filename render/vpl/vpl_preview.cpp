@@ -52,7 +52,7 @@ class SliceTransport final : public LightTransport {
 }  // namespace
 
 VplField buildVplField(const RenderScene& scene, const Camera& camera, std::shared_ptr<const VplSet> vpls,
-                       const PreviewSettings& settings) {
+                       const PreviewSettings& settings, const std::atomic<bool>* cancel) {
   VplField field;
   field.vpls = std::move(vpls);
   field.gather = gatherPrimaryHits(scene, camera);
@@ -60,7 +60,7 @@ VplField buildVplField(const RenderScene& scene, const Camera& camera, std::shar
   field.tree = buildSliceTree(field.gather.points, settings.slices, diagonal);
   field.minDistance = settings.clampFraction * diagonal;
   const SliceTransport transport(scene, field);
-  field.clusters = clusterLightSlice(field.vpls->vpls, field.gather.points, field.tree, transport, settings.clustering);
+  field.clusters = clusterLightSlice(field.vpls->vpls, field.gather.points, field.tree, transport, settings.clustering, cancel);
   field.rays = field.gather.rays + field.clusters.evaluations;
 
   // Which cluster a preview pass samples: by estimated contribution, with a defensive share so that

@@ -42,9 +42,10 @@ struct VplField {
   uint64_t rays = 0;
 };
 
-// The camera-dependent part; `vpls` is reused across camera moves.
+// The camera-dependent part; `vpls` is reused across camera moves. When *cancel becomes true the
+// clustering stops early and the (valid but incomplete) field is for the bin.
 VplField buildVplField(const RenderScene& scene, const Camera& camera, std::shared_ptr<const VplSet> vpls,
-                       const PreviewSettings& settings);
+                       const PreviewSettings& settings, const std::atomic<bool>* cancel = nullptr);
 
 PixelShaderFactory previewShader(const RenderScene& scene, const VplField& field, const PreviewSettings& settings);
 

@@ -61,6 +61,26 @@ TEST(Session, RestartAfterACameraMoveEqualsAFreshRender) {
   }
 }
 
+TEST(Session, MovesDuringEveryStageStillEndInTheFreshImage) {
+  // Camera moves that land in the quick stage, the (cancelled) clustering, the preview and the
+  // refinement: whatever was cut short, the last view's image is the fresh render's.
+  const auto scene = cornell();
+  const CameraData start = defaultCamera(scene->data());
+  SessionSettings s = small(SamplingMode::Mis, 3);
+  s.width = 96;
+  s.height = 72;
+  ProgressiveSession session(scene, start, s);
+  CameraData c = start;
+  for (int delayMs : {0, 5, 40, 120, 170, 200, 260, 400}) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(delayMs));
+    c = moved(c);
+    session.setCamera(c);
+  }
+  const Image after = finalImage(session);
+  ProgressiveSession fresh(scene, c, s);
+  EXPECT_EQ(relMse(after, finalImage(fresh)), 0.0);
+}
+
 TEST(Session, FlippingBackToAModeShowsItsOwnFilmAtOnce) {
   const auto scene = cornell();
   ProgressiveSession session(scene, defaultCamera(scene->data()), small(SamplingMode::Brdf, 3));
