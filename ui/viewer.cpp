@@ -110,9 +110,10 @@ int runViewer(const ViewerOptions& options) {
                         settings.guide.coneAngle * 57.29578f, settings.guide.bsdfProbability, settings.guide.defensive,
                         settings.guide.uniformMutation};
 
-    Image image;
+    Image image, variance;
     uint64_t version = 0;
     float exposure = options.exposure;
+    int view = 0;  // DisplayView
     bool showPanel = true;
     std::string message;
     const auto opened = Clock::now();
@@ -163,6 +164,10 @@ int runViewer(const ViewerOptions& options) {
         if (pressed(GLFW_KEY_R)) controller.reset();
         if (pressed(GLFW_KEY_F)) controller.frame();
         if (pressed(GLFW_KEY_TAB)) showPanel = !showPanel;
+        if (pressed(GLFW_KEY_V)) {
+          view = 1 - view;
+          display.upload(view == 0 ? image : variance);
+        }
         if (pressed(GLFW_KEY_ESCAPE)) glfwSetWindowShouldClose(window, GLFW_TRUE);
         for (int k = 0; k < 5; ++k)
           if (pressed(GLFW_KEY_1 + k)) session->setMode(kModes[k]);
@@ -170,7 +175,7 @@ int runViewer(const ViewerOptions& options) {
       if (controller.takeChanged()) session->setCamera(controller.camera());
       session->resize(fbWidth, fbHeight);  // ignores 0 x 0 (minimised) and unchanged sizes
 
-      if (session->latestImage(image, version)) display.upload(image);
+      if (session->latestImage(image, version, &variance)) display.upload(view == 0 ? image : variance);
       const SessionStats stats = session->stats();
 
       if (showPanel && (options.screenshot.empty() || options.screenshotPanel)) {
@@ -183,6 +188,8 @@ int runViewer(const ViewerOptions& options) {
         const char* names[] = {"1 BRDF", "2 Metropolis", "3 MIS", "4 mixture", "5 preview"};
         if (ImGui::Combo("mode", &modeIndex, names, 5)) session->setMode(kModes[modeIndex]);
         ImGui::SliderFloat("exposure", &exposure, -8.0f, 8.0f, "%.1f stops");
+        const char* views[] = {"image", "relative variance (log, 1e-4 black .. 1 white)"};
+        if (ImGui::Combo("view", &view, views, 2)) display.upload(view == 0 ? image : variance);
         ImGui::Text("%s  %d spp  %.1f s since restart", stageName(stats.stage), stats.spp, stats.sinceRestart);
         ImGui::Text("%.3g samples/s  %.3g rays/s  first frame %.0f ms", stats.samplesPerSecond, stats.raysPerSecond,
                     1e3 * stats.firstFrameSeconds);
@@ -228,7 +235,7 @@ int runViewer(const ViewerOptions& options) {
       ImGui::Render();
 
       if (fbWidth > 0 && fbHeight > 0) {
-        display.draw(fbWidth, fbHeight, exposure, DisplayView::Image);
+        display.draw(fbWidth, fbHeight, exposure, DisplayView(view));
         const bool shoot = !options.screenshot.empty() && secondsSince(opened) >= options.screenshotAfter;
         // What the window shows: read before the panel is drawn over it, unless it is wanted.
         if (shoot && !options.screenshotPanel) writePngBytes(options.screenshot, fbWidth, fbHeight, display.readPixels(fbWidth, fbHeight));

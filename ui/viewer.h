@@ -2,7 +2,7 @@
 // session's image through the display pipeline, camera navigation, and a Dear ImGui panel (mode,
 // guide and VPL parameters, exposure, live statistics, screenshot and EXR save).
 // Keys: 1-4 brdf / metropolis / mis / mixture, 5 preview, R reset camera, F frame the scene,
-// WASD/QE fly, Tab hide the panel, Esc quit.
+// WASD/QE fly, V toggle the relative-variance view, Tab hide the panel, Esc quit.
 #pragma once
 #include <string>
 #include "render/scene/render_scene.h"

@@ -120,10 +120,11 @@ void ProgressiveSession::resize(int width, int height) {
   changed_.notify_all();
 }
 
-bool ProgressiveSession::latestImage(Image& out, uint64_t& version) const {
+bool ProgressiveSession::latestImage(Image& out, uint64_t& version, Image* variance) const {
   std::lock_guard lock(mutex_);
   if (version_ == version) return false;
   out = shown_;
+  if (variance) *variance = shownVariance_.width > 0 ? shownVariance_ : Image(shown_.width, shown_.height);
   version = version_;
   return true;
 }
@@ -143,9 +144,10 @@ bool ProgressiveSession::waitUntilDone(double seconds) const {
   return changed_.wait_for(lock, std::chrono::duration<double>(seconds), [this] { return idle_ && !pending_; });
 }
 
-void ProgressiveSession::publish(const Image& image, SessionStage stage, int spp) {
+void ProgressiveSession::publish(const Image& image, SessionStage stage, int spp, Image variance) {
   std::lock_guard lock(mutex_);
   shown_ = image;
+  shownVariance_ = std::move(variance);
   ++version_;
   stats_.stage = stage;
   stats_.spp = spp;
@@ -279,7 +281,8 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
   }
   const TileRenderer renderer(camera, settings_.seed, pathTracerShader(tracer_, continuation));
   // A mode flipped back to shows its own film at once, if it has passed the handover.
-  if (mine.complete >= settings_.handoverSpp) publish(mine.film->resolve(), SessionStage::Refine, mine.complete);
+  if (mine.complete >= settings_.handoverSpp)
+    publish(mine.film->resolve(), SessionStage::Refine, mine.complete, mine.film->resolveVariance());
   while (mine.complete < settings_.maxSpp) {
     const auto t = Clock::now();
     const PassStats pass = renderer.renderPass(*mine.film, mine.nextPass++, &cancel_);
@@ -295,7 +298,7 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
     if (cancelled()) return;
     ++mine.complete;
     if (mine.complete >= settings_.handoverSpp || preview.complete == 0)
-      publish(mine.film->resolve(), SessionStage::Refine, mine.complete);
+      publish(mine.film->resolve(), SessionStage::Refine, mine.complete, mine.film->resolveVariance());
     noteTime();
   }
 }

@@ -71,7 +71,9 @@ class ProgressiveSession {
   void resize(int width, int height);  // sizes below 1 are ignored (a minimised window)
 
   // Copies the newest image into `out` when it is newer than `version` (then updated); else false.
-  bool latestImage(Image& out, uint64_t& version) const;
+  // `variance`, when given, gets the per-pixel relative variance of the path-traced estimate (its
+  // error, DESIGN.md §4, as the samples themselves predict it); zeros while the preview is shown.
+  bool latestImage(Image& out, uint64_t& version, Image* variance = nullptr) const;
   SessionStats stats() const;
   const SessionSettings& settings() const { return settings_; }
   CameraData camera() const;
@@ -84,7 +86,7 @@ class ProgressiveSession {
   struct CameraState;
   void controllerLoop();
   void runUntilChanged(CameraState& state, const Request& request);
-  void publish(const Image& image, SessionStage stage, int spp);
+  void publish(const Image& image, SessionStage stage, int spp, Image variance = {});
   bool cancelled() const { return cancel_.load(std::memory_order_relaxed); }
 
   std::shared_ptr<const RenderScene> scene_;
@@ -96,7 +98,7 @@ class ProgressiveSession {
   mutable std::condition_variable changed_;
   std::unique_ptr<Request> pending_;
   bool quit_ = false, idle_ = false;
-  Image shown_;
+  Image shown_, shownVariance_;
   uint64_t version_ = 0;
   SessionStats stats_;
   CameraData camera_;

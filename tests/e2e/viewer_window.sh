@@ -9,6 +9,12 @@ exe=$1; repo=$2
 command -v xvfb-run >/dev/null || { echo "SKIP: xvfb-run is missing (scripts/setup.sh installs xvfb)"; exit 77; }
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
 scene=$repo/scenes/cornell_box.gltf
+# A scene that does not load: one line, exit 2, and no window.
+printf '{"asset":{"version":"2.0"' > "$tmp/broken.gltf"
+timeout 60 xvfb-run -a "$exe" "$tmp/broken.gltf" --screenshot "$tmp/none.png" 2> "$tmp/err"
+rc=$?
+[ $rc = 2 ] && [ "$(grep -c . "$tmp/err")" = 1 ] || { echo "FAIL: broken scene gave exit $rc: $(cat "$tmp/err")"; exit 1; }
+[ ! -s "$tmp/none.png" ] || { echo "FAIL: a window was shown for a broken scene"; exit 1; }
 timeout 120 xvfb-run -a -s "-screen 0 640x480x24" "$exe" "$scene" --width 320 --height 240 --threads 2 \
     --screenshot "$tmp/window.png" --screenshot-after 3 --stats-log "$tmp/stats.txt"
 rc=$?

@@ -1,6 +1,7 @@
 // The display pipeline in a headless OSMesa context against the render core's own tonemap: what
 // the window shows is the image the PNG writer makes, for any exposure.
 #include <cmath>
+#include "render/film/image_metrics.h"
 #include "render/film/tonemap.h"
 #include "render/session/render_job.h"
 #include "tests/unit/support.h"
@@ -37,6 +38,21 @@ TEST(Display, CaptureEqualsTheTonemappedImageAtTwoExposures) {
   s.spp = 4;
   const Image cornell = runRenderJob(s).image;
   for (float exposure : {0.0f, 1.0f}) EXPECT_LE(worstLevelDifference(cornell, exposure), 1) << exposure;
+}
+
+TEST(Display, ErrorViewEqualsTheFalseColourOfTheRenderCore) {
+  // Relative variances over six decades, and zeros: the shader's ramp is image_metrics' ramp.
+  Image errors(120, 9);
+  for (int y = 0; y < errors.height; ++y)
+    for (int x = 0; x < errors.width; ++x)
+      errors.at(x, y) = glm::vec3(y == 0 ? 0.0f : std::pow(10.0f, -5.0f + 6.0f * float(x) / float(errors.width - 1)));
+  const std::vector<uint8_t> shown = ui::captureThroughDisplay(errors, 3.0f, ui::DisplayView::ErrorMap);  // exposure ignored
+  const Image expected = falseColourLog(errors);
+  int worst = 0;
+  for (size_t i = 0; i < errors.pixels.size(); ++i)
+    for (int c = 0; c < 3; ++c)
+      worst = std::max(worst, std::abs(int(shown[3 * i + size_t(c)]) - int(toDisplayByte(expected.pixels[i][c], 0.0f))));
+  EXPECT_LE(worst, 2);
 }
 
 TEST(Display, OnePixelAndOddSizes) {

@@ -115,6 +115,22 @@ TEST(Session, ShowsAFullFrameFirstAndNeverANonFiniteOne) {
   EXPECT_GT(session.stats().cachePoints, 0u);
 }
 
+TEST(Session, RefinementComesWithItsRelativeVariance) {
+  const auto scene = cornell();
+  ProgressiveSession session(scene, defaultCamera(scene->data()), small(SamplingMode::Brdf, 8));
+  ASSERT_TRUE(session.waitUntilDone(120.0));
+  Image image, variance;
+  uint64_t version = 0;
+  ASSERT_TRUE(session.latestImage(image, version, &variance));
+  ASSERT_EQ(variance.pixels.size(), image.pixels.size());
+  double sum = 0.0;
+  for (const glm::vec3& v : variance.pixels) {
+    ASSERT_TRUE(std::isfinite(v.x) && v.x >= 0.0f);
+    sum += v.x;
+  }
+  EXPECT_GT(sum, 0.0);  // 8 noisy samples per pixel
+}
+
 TEST(Session, DestructionMidRenderJoinsEveryThread) {
   const auto scene = cornell();
   for (int i = 0; i < 5; ++i) {
