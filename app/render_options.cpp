@@ -62,6 +62,8 @@ void RenderOptions::addCommonTo(CLI::App& command) {
   command.add_option("--normal-scale", preview.slices.normalScale, "6D kd-tree normal weight (0: scene diagonal / 16)")
       ->check(CLI::NonNegativeNumber);
   command.add_option("--global-clusters", preview.clustering.globalClusters, "LightSlice global clusters")->check(CLI::Range(1, 1 << 20));
+  command.add_option("--refinement-rows", preview.clustering.refinementRows,
+                     "LightSlice: reduced rows nearest a slice that estimate its cluster errors")->check(CLI::Range(1, 1024));
   command.add_option("--clusters", preview.clustering.clusterBudget, "VPL clusters per slice (budget)")->check(CLI::Range(1, 1 << 20));
   command.add_option("--vpl-clamp", preview.clampFraction, "geometry clamp distance as a fraction of the scene diagonal")
       ->check(CLI::Range(0.0f, 0.99f));
@@ -69,6 +71,9 @@ void RenderOptions::addCommonTo(CLI::App& command) {
   command.add_option("--cone-spread", guide.spreadScale,
                      "a cluster's guide cone is at least atan(this x its spread / distance); 0: the fixed cone only")
       ->check(CLI::Range(0.0f, 1000.0f));
+  command.add_option("--guided-vertices", guide.guidedVertices,
+                     "guide only the first N vertices of every path (the authors guided 1); 0: every vertex near a cache point")
+      ->check(CLI::Range(0, 1024));
   command.add_option("--defensive", guide.defensive, "uniform share of the guide pdf")->check(CLI::Range(1e-6f, 1.0f));
   command.add_option("--uniform-mutation", guide.uniformMutation, "Metropolis: probability of an independent direction")
       ->check(CLI::Range(0.0f, 1.0f));

@@ -18,8 +18,14 @@ int GuidedContinuation::cachePoint(const SurfaceHit& hit) {
     lastPosition_ = hit.position;
     lastNormal_ = hit.shadingNormal;
     // The camera ray's hit usually belongs to its pixel's slice: try that cache point first.
-    lastCachePoint_ = primaryVertex_ ? field_.pixelCachePoint(pixel_, hit.position, hit.shadingNormal) : -1;
-    if (lastCachePoint_ < 0) lastCachePoint_ = field_.lookup(hit.position, hit.shadingNormal);
+    ++vertex_;
+    const int maxGuided = field_.settings().guidedVertices;
+    if (maxGuided > 0 && vertex_ > maxGuided) {
+      lastCachePoint_ = -1;
+    } else {
+      lastCachePoint_ = primaryVertex_ ? field_.pixelCachePoint(pixel_, hit.position, hit.shadingNormal) : -1;
+      if (lastCachePoint_ < 0) lastCachePoint_ = field_.lookup(hit.position, hit.shadingNormal);
+    }
     primaryVertex_ = false;
   }
   return lastCachePoint_;

@@ -24,6 +24,8 @@ class GuidedContinuation final : public ContinuationSampler {
     chainsUsedByPath_.clear();
     pixel_ = pixel;
     primaryVertex_ = true;
+    vertex_ = 0;
+    lastPosition_ = glm::vec3(NAN);  // a new path's first vertex is always a new vertex
   }
 
  private:
@@ -43,6 +45,7 @@ class GuidedContinuation final : public ContinuationSampler {
   int lastCachePoint_ = -1;
   uint64_t pixel_ = 0;
   bool primaryVertex_ = false;  // the next new vertex is the camera ray's hit
+  int vertex_ = 0;              // vertices of this path so far (1: the camera ray's hit)
 };
 
 }  // namespace vpl

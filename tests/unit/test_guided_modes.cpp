@@ -8,8 +8,10 @@
 namespace vpl {
 namespace {
 
-RenderJobResult render(const std::string& scene, SamplingMode mode, int spp, uint64_t seed) {
+RenderJobResult render(const std::string& scene, SamplingMode mode, int spp, uint64_t seed,
+                       int guidedVertices = GuideSettings{}.guidedVertices) {
   RenderJobSettings s;
+  s.guide.guidedVertices = guidedVertices;
   s.scenePath = test::sourceDir() + "/scenes/" + scene;
   s.mode = mode;
   s.width = 32;
@@ -37,6 +39,7 @@ double meanDifferenceInSigmas(const Image& a, const Image& b, int channel) {
 struct Case {
   const char* scene;
   SamplingMode mode;
+  int guidedVertices = GuideSettings{}.guidedVertices;  // 0: every vertex near a cache point
 };
 
 class GuidedModes : public ::testing::TestWithParam<Case> {};
@@ -44,7 +47,7 @@ class GuidedModes : public ::testing::TestWithParam<Case> {};
 TEST_P(GuidedModes, AgreeWithBsdfSampling) {
   const Case c = GetParam();
   const RenderJobResult reference = render(c.scene, SamplingMode::Brdf, 1024, 1);
-  const RenderJobResult guided = render(c.scene, c.mode, 1024, 2);
+  const RenderJobResult guided = render(c.scene, c.mode, 1024, 2, c.guidedVertices);
   EXPECT_GT(guided.guideSamples, 0u) << "the guide was never used";
   EXPECT_EQ(guided.discarded, 0u);
   for (int ch = 0; ch < 3; ++ch) {
@@ -59,9 +62,13 @@ TEST_P(GuidedModes, AgreeWithBsdfSampling) {
 INSTANTIATE_TEST_SUITE_P(Scenes, GuidedModes,
                          ::testing::Values(Case{"cornell_box.gltf", SamplingMode::Mis}, Case{"cornell_box.gltf", SamplingMode::Metropolis},
                                            Case{"cornell_box.gltf", SamplingMode::Mixture}, Case{"two_rooms.gltf", SamplingMode::Mis},
-                                           Case{"two_rooms.gltf", SamplingMode::Metropolis}, Case{"two_rooms.gltf", SamplingMode::Mixture}),
+                                           Case{"two_rooms.gltf", SamplingMode::Metropolis}, Case{"two_rooms.gltf", SamplingMode::Mixture},
+                                           // Guiding every vertex near a cache point (--guided-vertices 0).
+                                           Case{"two_rooms.gltf", SamplingMode::Mis, 0}, Case{"cornell_box.gltf", SamplingMode::Metropolis, 0},
+                                           Case{"two_rooms.gltf", SamplingMode::Mixture, 0}),
                          [](const auto& info) {
-                           return std::string(info.param.scene[0] == 'c' ? "Cornell" : "TwoRooms") + "_" + modeName(info.param.mode);
+                           return std::string(info.param.scene[0] == 'c' ? "Cornell" : "TwoRooms") + "_" + modeName(info.param.mode) +
+                                  (info.param.guidedVertices == 0 ? "_EveryVertex" : "");
                          });
 
 TEST(GuidedModes, ErrorFallsAsOneOverSpp) {
