@@ -1,6 +1,9 @@
 // The viewer's progressive session without a window: restarts discard the old view's samples,
 // modes keep their own films, every thread is joined on destruction.
 #include <chrono>
+#include <cstdlib>
+#include <memory>
+#include <tbb/global_control.h>
 #include <thread>
 #include "render/film/image_metrics.h"
 #include "render/scene/gltf_loader.h"
@@ -9,6 +12,21 @@
 
 namespace vpl {
 namespace {
+
+// ThreadSanitizer cannot see the synchronisation inside Debian's uninstrumented libtbb, and reports
+// every hand-over between its workers. VPLVIEW_SERIAL_TBB=1 keeps TBB to the calling thread, so a
+// TSan run checks the session's own threads (the test thread, the controller) and their protocol.
+class SerialTbbForSanitizers : public ::testing::Environment {
+ public:
+  void SetUp() override {
+    if (std::getenv("VPLVIEW_SERIAL_TBB")) limit_ = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, 1);
+  }
+  void TearDown() override { limit_.reset(); }
+
+ private:
+  std::unique_ptr<tbb::global_control> limit_;
+};
+const auto* const kSerialTbb = ::testing::AddGlobalTestEnvironment(new SerialTbbForSanitizers);
 
 std::shared_ptr<const RenderScene> cornell() {
   return std::make_shared<const RenderScene>(loadGltf(test::sourceDir() + "/scenes/cornell_box.gltf"));
