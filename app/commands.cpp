@@ -1,6 +1,7 @@
 #include "app/commands.h"
 
 #include <cstdio>
+#include <optional>
 #include <sstream>
 #include <unistd.h>
 #include <nlohmann/json.hpp>
@@ -11,6 +12,7 @@
 #include "render/session/progress_bar.h"
 #include "render/session/render_job.h"
 #include "render/session/ray_benchmark.h"
+#include "app/converge.h"
 #include "app/render_options.h"
 #include "ui/osmesa_capture.h"
 #include "ui/viewer.h"
@@ -19,7 +21,11 @@ namespace vpl::app {
 
 namespace {
 
-RenderOptions gRender, gBench, gCapture;
+RenderOptions gRender, gBench, gCapture, gReference, gConverge;
+ConvergeOptions gConvergeOnly;
+constexpr uint64_t kReferenceSeed = 1000;
+CLI::App* gReferenceCommand = nullptr;
+CLI::App* gConvergeCommand = nullptr;
 CLI::App* gRenderCommand = nullptr;
 CLI::App* gCaptureCommand = nullptr;
 RenderOptions gViewer;  // the viewer reuses the mode, size, seed, thread, exposure and VPL/guide flags
@@ -62,20 +68,21 @@ nlohmann::ordered_json summaryJson(const RenderJobSettings& s, const RenderJobRe
   return j;
 }
 
-int runRender() {
-  RenderJobSettings settings = gRender.toSettings();
-  tbb::global_control threads(tbb::global_control::max_allowed_parallelism, gRender.threadCount());
+int runRender(const RenderOptions& options, std::optional<SamplingMode> forcedMode = std::nullopt) {
+  RenderJobSettings settings = options.toSettings();
+  if (forcedMode) settings.mode = *forcedMode;
+  tbb::global_control threads(tbb::global_control::max_allowed_parallelism, options.threadCount());
   // Check the outputs before spending minutes on a render that cannot be saved.
-  checkWritable(gRender.out);
-  if (!gRender.png.empty()) checkWritable(gRender.png);
+  checkWritable(options.out);
+  if (!options.png.empty()) checkWritable(options.png);
 
   ProgressBar bar("render", isatty(STDERR_FILENO) != 0);
   const RenderJobResult result = runRenderJob(settings, [&](double f) { bar.update(f, ""); });
   bar.finish();
   for (const std::string& notice : result.notices) std::fprintf(stderr, "vplview: note: %s\n", notice.c_str());
 
-  writeExr(gRender.out, result.image);
-  if (!gRender.png.empty()) writePng(gRender.png, result.image, gRender.exposure);
+  writeExr(options.out, result.image);
+  if (!options.png.empty()) writePng(options.png, result.image, options.exposure);
   std::printf("%s\n", summaryJson(settings, result).dump().c_str());
   return 0;
 }
@@ -157,6 +164,13 @@ void registerCommands(CLI::App& app) {
   gRenderCommand = app.add_subcommand("render", "render a scene headlessly to EXR (and PNG)");
   gRender.addTo(*gRenderCommand, /*requireOut=*/true);
 
+  gReferenceCommand = app.add_subcommand("reference", "render a brdf reference for relMSE measurements (EXR; seed 1000 unless --seed)");
+  gReference.addTo(*gReferenceCommand, /*requireOut=*/true);
+
+  gConvergeCommand = app.add_subcommand("converge", "relMSE and bias of each mode against a reference at growing time budgets");
+  gConverge.addConvergeTo(*gConvergeCommand);
+  gConvergeOnly.addTo(*gConvergeCommand);
+
   gCaptureCommand = app.add_subcommand("capture", "render headlessly and save what the viewer's display would show (OSMesa)");
   gCapture.addTo(*gCaptureCommand, /*requireOut=*/true);
 
@@ -185,7 +199,13 @@ void registerCommands(CLI::App& app) {
 
 int runSelectedCommand(CLI::App& app) {
   if (gCompareCommand->parsed()) return runCompare();
-  if (gRenderCommand->parsed()) return runRender();
+  if (gRenderCommand->parsed()) return runRender(gRender);
+  if (gReferenceCommand->parsed()) {
+    // Renders default to seed 1: a reference with the same random numbers would flatter them.
+    if (gReferenceCommand->count("--seed") == 0) gReference.seed = kReferenceSeed;
+    return runRender(gReference, SamplingMode::Brdf);
+  }
+  if (gConvergeCommand->parsed()) return runConverge(gConvergeOnly, gConverge, *gConvergeCommand);
   if (gBenchCommand->parsed()) return runBench();
   if (gCaptureCommand->parsed()) return runCapture();
   (void)app;

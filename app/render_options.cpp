@@ -46,6 +46,11 @@ void RenderOptions::addViewerOptionsTo(CLI::App& app) {
   addCommonTo(app);
 }
 
+void RenderOptions::addConvergeTo(CLI::App& command) {
+  command.add_option("scene", scene, "glTF 2.0 scene (.gltf or .glb)")->required();
+  addCommonTo(command);
+}
+
 void RenderOptions::addCommonTo(CLI::App& command) {
   command.add_option("--mode", mode, "brdf | metropolis | mis | mixture | preview")
       ->check(CLI::IsMember({"brdf", "metropolis", "mis", "mixture", "preview"}));

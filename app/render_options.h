@@ -25,6 +25,7 @@ struct RenderOptions {
 
   void addTo(CLI::App& command, bool requireOut);  // a headless command: scene, budget, outputs, the rest
   void addViewerOptionsTo(CLI::App& app);           // the viewer: an optional scene and the rest
+  void addConvergeTo(CLI::App& command);            // converge: a scene and the rest (budgets and size come with it)
   // Checked conversion; throws InputError for values CLI11 cannot check alone.
   RenderJobSettings toSettings() const;
   int threadCount() const;

@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# vplview reference + converge end to end: the CSV has its header and one row per mode and budget,
+# samples grow with the budget, the plot is a PNG, and bad input gets exit 2 with one line.
+# Usage (CTest): converge_cli.sh PATH/TO/vplview REPO_ROOT.
+set -u
+exe=$1; repo=$2
+tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+scene=$repo/scenes/cornell_box.gltf
+fail() { echo "FAIL: $*"; exit 1; }
+"$exe" reference "$scene" --spp 64 --width 40 --height 30 --out "$tmp/ref.exr" >/dev/null || fail "reference"
+"$exe" converge "$scene" --reference "$tmp/ref.exr" --modes brdf,mis --times 0.2,0.6 --out-dir "$tmp/out" \
+    > "$tmp/stdout" || fail "converge exited $?"
+tail -1 "$tmp/stdout" | python3 -c "import json,sys; j=json.load(sys.stdin); assert j['runs'] == 4" || fail "JSON line"
+python3 - "$tmp/out/converge.csv" <<'PY' || fail "CSV"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+assert set(["mode", "seconds", "spp", "relmse", "bias"]) <= set(rows[0].keys()), rows[0].keys()
+assert [r["mode"] for r in rows] == ["brdf", "brdf", "mis", "mis"], rows
+for mode in ("brdf", "mis"):
+    short, long = [r for r in rows if r["mode"] == mode]
+    assert int(long["spp"]) > int(short["spp"]) > 0, (short, long)
+    assert float(short["relmse"]) >= 0 and abs(float(short["bias"])) < 0.5
+print("csv ok:", len(rows), "rows")
+PY
+[ "$(head -c 4 "$tmp/out/converge.png" | od -An -tx1 | tr -d ' \n')" = "89504e47" ] || fail "no PNG plot"
+bad() {
+  "$exe" "$@" > /dev/null 2> "$tmp/err"; rc=$?
+  [ $rc = 2 ] && [ "$(grep -c . "$tmp/err")" = 1 ] || fail "'$*' gave exit $rc: $(cat "$tmp/err")"
+}
+bad converge "$scene" --reference "$tmp/ref.exr" --modes brdf,nope --times 1 --out-dir "$tmp/x"
+bad converge "$scene" --reference "$tmp/ref.exr" --times 1,-2 --out-dir "$tmp/x"
+bad converge "$scene" --reference "$tmp/missing.exr" --times 1 --out-dir "$tmp/x"
+bad converge "$scene" --reference "$tmp/ref.exr" --times 1 --width 41 --out-dir "$tmp/x"
+echo "ok: converge and reference"
