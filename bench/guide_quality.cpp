@@ -34,6 +34,7 @@ Moments measure(const RenderScene& scene, const PathTracer& tracer, const GuideF
   at.position = cp.position;
   at.shadingNormal = cp.normal;
   at.geometricNormal = cp.normal;
+  at.coordinateScale = scene.coordinateScale();
   const Bsdf bsdf = scene.bsdf(at);
   const int side = int(std::sqrt(double(directions)));
   const float pBsdf = field.settings().bsdfProbability;

@@ -29,7 +29,9 @@ struct RayHit {
 // Moves a ray origin off a surface by a few ULPs along the geometric normal, so that offsets scale
 // with the coordinates (Wächter & Binder, "A Fast and Robust Method for Avoiding Self-Intersection",
 // Ray Tracing Gems, ch. 6). Works for scenes of any scale.
-glm::vec3 offsetRayOrigin(const glm::vec3& p, const glm::vec3& geometricNormal);
+// `coordinateScale` is the magnitude of the coordinates p was computed from (its triangle's vertices):
+// near zero a coordinate's rounding error follows that scale, not the coordinate itself.
+glm::vec3 offsetRayOrigin(const glm::vec3& p, const glm::vec3& geometricNormal, float coordinateScale);
 
 struct AlphaMask;  // what the cut-out filter needs to evaluate a texel
 

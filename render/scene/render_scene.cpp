@@ -36,6 +36,8 @@ SurfaceHit RenderScene::surface(const Ray& ray, const RayHit& hit) const {
   s.material = mesh.material;
   // Barycentric interpolation is more precise than origin + t * direction far from the origin.
   s.position = p0 * b0 + p1 * hit.u + p2 * hit.v;
+  const glm::vec3 magnitude = glm::max(glm::abs(p0), glm::max(glm::abs(p1), glm::abs(p2)));
+  s.coordinateScale = std::max(magnitude.x, std::max(magnitude.y, magnitude.z));
 
   glm::vec3 ng = glm::cross(p1 - p0, p2 - p0);
   const float len = glm::length(ng);
@@ -85,7 +87,7 @@ BsdfParams RenderScene::bsdfParams(const SurfaceHit& hit) const {
 Ray spawnRay(const SurfaceHit& from, const glm::vec3& wi) {
   Ray r;
   const glm::vec3 n = glm::dot(wi, from.geometricNormal) >= 0.0f ? from.geometricNormal : -from.geometricNormal;
-  r.origin = offsetRayOrigin(from.position, n);
+  r.origin = offsetRayOrigin(from.position, n, from.coordinateScale);
   r.direction = wi;
   return r;
 }

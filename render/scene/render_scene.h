@@ -1,6 +1,7 @@
 // The immutable snapshot the renderer works on: scene data, its Embree BVH, its emitters, and the
 // conversion of a ray hit into a shading point. Built once per loaded scene; shared by all threads.
 #pragma once
+#include <algorithm>
 #include <memory>
 #include <glm/glm.hpp>
 #include "render/material/bsdf.h"
@@ -26,6 +27,11 @@ class RenderScene {
   const EmitterSet& emitters() const { return emitters_; }
   glm::vec3 centre() const { return centre_; }
   float radius() const { return radius_; }
+  // Largest |coordinate| of the scene bounds: the rounding scale of points with no triangle at hand.
+  float coordinateScale() const {
+    const glm::vec3 m = glm::max(glm::abs(data_.boundsMin), glm::abs(data_.boundsMax));
+    return std::max(m.x, std::max(m.y, m.z));
+  }
   // True when the sky was switched on because the scene has no light (the CLI prints a notice).
   bool usesDefaultSky() const { return defaultSky_; }
 

@@ -12,6 +12,7 @@ struct SurfaceHit {
   glm::vec2 uv0{0.0f}, uv1{0.0f};
   uint32_t mesh = 0, triangle = 0, material = 0;
   bool frontFace = true;  // the ray arrived on the side the triangle's winding faces
+  float coordinateScale = 1.0f;  // largest |coordinate| of the triangle's vertices: the hit point's rounding scale
 };
 
 }  // namespace vpl

@@ -42,7 +42,9 @@ RayBenchmark measureRawRayRate(const std::string& scenePath, double seconds, uin
     const glm::vec2 b = sampleUniformTriangle(rng.uniform2());
     const glm::vec3 n = glm::normalize(glm::cross(p1 - p0, p2 - p0));
     const glm::vec3 d = sampleUniformSphere(rng.uniform2());
-    rays[i].origin = offsetRayOrigin(p0 * (1 - b.x - b.y) + p1 * b.x + p2 * b.y, glm::dot(d, n) >= 0 ? n : -n);
+    const glm::vec3 magnitude = glm::max(glm::abs(p0), glm::max(glm::abs(p1), glm::abs(p2)));
+    rays[i].origin = offsetRayOrigin(p0 * (1 - b.x - b.y) + p1 * b.x + p2 * b.y, glm::dot(d, n) >= 0 ? n : -n,
+                                     std::max(magnitude.x, std::max(magnitude.y, magnitude.z)));
     rays[i].direction = d;
   });
 

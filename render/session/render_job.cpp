@@ -56,11 +56,17 @@ std::string RenderJobSettings::validate() const {
 
 RenderJobResult runRenderJob(const RenderJobSettings& settings, const std::function<void(double)>& progress) {
   if (std::string e = settings.validate(); !e.empty()) throw InputError(e);
-
-  RenderJobResult result;
   const auto start = Clock::now();
   SceneData data = loadGltf(settings.scenePath);
-  result.timings.load = secondsSince(start);
+  const double load = secondsSince(start);
+  RenderJobResult result = runRenderJob(settings, std::move(data), progress);
+  result.timings.load = load;
+  return result;
+}
+
+RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, const std::function<void(double)>& progress) {
+  if (std::string e = settings.validate(); !e.empty()) throw InputError(e);
+  RenderJobResult result;
   result.notices = data.notices;
   result.triangles = data.triangleCount();
 

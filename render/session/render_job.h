@@ -51,5 +51,8 @@ struct RenderJobResult {
 // progress(fraction in [0,1]) is called after every pass.
 RenderJobResult runRenderJob(const RenderJobSettings& settings,
                              const std::function<void(double)>& progress = nullptr);
+// The same on a scene already in memory (settings.scenePath is then only a name).
+RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data,
+                             const std::function<void(double)>& progress = nullptr);
 
 }  // namespace vpl

@@ -31,7 +31,7 @@ void traceLightPath(const RenderScene& scene, const VplSettings& settings, uint6
   glm::vec3 beta = emission->weight;
   Ray ray;
   ray.origin = emission->normal == glm::vec3(0.0f) ? emission->position
-                                                   : offsetRayOrigin(emission->position, emission->normal);
+                                                   : offsetRayOrigin(emission->position, emission->normal, scene.coordinateScale());
   ray.direction = emission->direction;
   for (int depth = 1; depth <= settings.maxDepth; ++depth) {
     const RayHit hit = scene.accel().intersect(ray);
