@@ -1,0 +1,14 @@
+#!/usr/bin/env bash
+# The whole test suite again under AddressSanitizer + UndefinedBehaviorSanitizer, built in its own
+# folder (BUILD/asan). Any sanitizer report fails it; LeakSanitizer ignores only Mesa's own
+# allocations (tests/sanitizers/lsan.supp). Usage (CTest): asan_suite.sh PATH/TO/vplview REPO_ROOT.
+set -u
+build=$(cd "$(dirname "$1")" && pwd); repo=$2
+asan=$build/asan
+cmake -S "$repo" -B "$asan" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DVPLVIEW_SANITIZE=address,undefined >/dev/null || exit 1
+cmake --build "$asan" --parallel "$(nproc)" >/dev/null || { echo "FAIL: the sanitizer build failed"; exit 1; }
+export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+export LSAN_OPTIONS="suppressions=$repo/tests/sanitizers/lsan.supp"
+# The sanitizer runs of the sanitizer tests themselves, and the Node validator, are left out.
+cd "$asan" && ctest --output-on-failure --timeout 900 -E "asan_suite|tsan_session|gltf_validator"
