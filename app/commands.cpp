@@ -68,6 +68,15 @@ nlohmann::ordered_json summaryJson(const RenderJobSettings& s, const RenderJobRe
   return j;
 }
 
+// A render job with the progress bar on a terminal and the scene's notices on stderr.
+RenderJobResult renderWithProgress(const RenderJobSettings& settings, const char* label) {
+  ProgressBar bar(label, isatty(STDERR_FILENO) != 0);
+  RenderJobResult result = runRenderJob(settings, [&](double f) { bar.update(f, ""); });
+  bar.finish();
+  for (const std::string& notice : result.notices) std::fprintf(stderr, "vplview: note: %s\n", notice.c_str());
+  return result;
+}
+
 int runRender(const RenderOptions& options, std::optional<SamplingMode> forcedMode = std::nullopt) {
   RenderJobSettings settings = options.toSettings();
   if (forcedMode) settings.mode = *forcedMode;
@@ -75,11 +84,7 @@ int runRender(const RenderOptions& options, std::optional<SamplingMode> forcedMo
   // Check the outputs before spending minutes on a render that cannot be saved.
   checkWritable(options.out);
   if (!options.png.empty()) checkWritable(options.png);
-
-  ProgressBar bar("render", isatty(STDERR_FILENO) != 0);
-  const RenderJobResult result = runRenderJob(settings, [&](double f) { bar.update(f, ""); });
-  bar.finish();
-  for (const std::string& notice : result.notices) std::fprintf(stderr, "vplview: note: %s\n", notice.c_str());
+  const RenderJobResult result = renderWithProgress(settings, "render");
 
   writeExr(options.out, result.image);
   if (!options.png.empty()) writePng(options.png, result.image, options.exposure);
@@ -107,10 +112,7 @@ int runCapture() {
   RenderJobSettings settings = gCapture.toSettings();
   tbb::global_control threads(tbb::global_control::max_allowed_parallelism, gCapture.threadCount());
   checkWritable(gCapture.out);
-  ProgressBar bar("capture", isatty(STDERR_FILENO) != 0);
-  const RenderJobResult result = runRenderJob(settings, [&](double f) { bar.update(f, ""); });
-  bar.finish();
-  for (const std::string& notice : result.notices) std::fprintf(stderr, "vplview: note: %s\n", notice.c_str());
+  const RenderJobResult result = renderWithProgress(settings, "capture");
   // Through the viewer's own display code, in a software OpenGL context.
   writePngBytes(gCapture.out, result.image.width, result.image.height,
                 ui::captureThroughDisplay(result.image, gCapture.exposure));

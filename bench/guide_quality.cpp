@@ -6,6 +6,7 @@
 // the BSDF at equal sample count. Usage:
 //   guide_quality SCENE [cache points=48] [directions=4096] [paths per direction=8] [width=320] [height=240]
 // Environment overrides of the defaults: GQ_VPLS (count), GQ_CONE (degrees), GQ_DEFENSIVE, GQ_CLAMP, GQ_SPREAD.
+// GQ_DUMP=C prints cache point C and each direction's share of the guide's second moment on stderr.
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -39,6 +40,7 @@ Moments measure(const RenderScene& scene, const PathTracer& tracer, const GuideF
   const int side = int(std::sqrt(double(directions)));
   const float pBsdf = field.settings().bsdfProbability;
   Moments m;
+  const bool dump = std::getenv("GQ_DUMP") && std::atoi(std::getenv("GQ_DUMP")) == c;
   Rng rng(seed, uint64_t(c));
   BsdfContinuation continuation;
   PathStats stats;
@@ -63,11 +65,11 @@ Moments measure(const RenderScene& scene, const PathTracer& tracer, const GuideF
     m.bsdf += (pb > 0 ? g * g / (pb * pu) : (g > 0 ? INFINITY : 0.0)) / n;
     m.guide += g * g / (pg * pu) / n;
     m.mis += g * g / (pm * pu) / n;
-    if (std::getenv("GQ_DUMP") && std::atoi(std::getenv("GQ_DUMP")) == c && g > 0)
+    if (dump && g > 0)
       std::fprintf(stderr, "w %6.3f %6.3f %6.3f cos %.3f g %.4g pg %.4g pb %.4g g2/pg %.4g\n", w.x, w.y, w.z,
                    glm::dot(w, cp.normal), g, pg, pb, g * g / (pg * pu) / n);
   }
-  if (std::getenv("GQ_DUMP") && std::atoi(std::getenv("GQ_DUMP")) == c)
+  if (dump)
     std::fprintf(stderr, "cache %d at %.3f %.3f %.3f n %.3f %.3f %.3f radius %.3f\n", c, cp.position.x, cp.position.y,
                  cp.position.z, cp.normal.x, cp.normal.y, cp.normal.z, cp.radius);
   return m;

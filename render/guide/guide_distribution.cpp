@@ -57,8 +57,12 @@ class CellCentres {
   Tree tree_;
 };
 
-// |w - d|^2 = 2 (1 - cos) for unit vectors; 1 - cos = 2 sin^2(theta/2) avoids cancellation.
-float chord2FromCos(float cosCone) { return 2.0f * (1.0f - cosCone); }
+// A cone around a unit vector is a ball of this squared chord: |w - d|^2 = 2 (1 - cos theta). From
+// the angle, 4 sin^2(theta/2) keeps its precision for narrow cones, where 1 - cos cancels.
+float chord2FromAngle(float angle) {
+  const float s = std::sin(0.5f * std::min(angle, 3.14159265f));
+  return 4.0f * s * s;
+}
 
 }  // namespace
 
@@ -66,11 +70,11 @@ int GuideDistribution::cellOf(const glm::vec3& w) { return equalAreaCell(w, kRes
 glm::vec3 GuideDistribution::cellCentre(int cell) { return CellCentres::get().centre(cell); }
 
 void GuideDistribution::coneCells(const glm::vec3& d, float cosCone, std::vector<uint32_t>& cells) {
-  CellCentres::get().within(d, chord2FromCos(cosCone), cells);
+  CellCentres::get().within(d, 2.0f * (1.0f - cosCone), cells);
 }
 
 void GuideDistribution::coneCellsLinear(const glm::vec3& d, float cosCone, std::vector<uint32_t>& cells) {
-  const float chord2 = chord2FromCos(cosCone);
+  const float chord2 = 2.0f * (1.0f - cosCone);
   for (int c = 0; c < kCells; ++c) {
     const glm::vec3 e = cellCentre(c) - d;
     if (glm::dot(e, e) <= chord2) cells.push_back(uint32_t(c));
@@ -80,11 +84,7 @@ void GuideDistribution::coneCellsLinear(const glm::vec3& d, float cosCone, std::
 GuideDistribution::GuideDistribution(const std::vector<GuideRepresentative>& representatives, float coneAngle,
                                      float defensive)
     : defensive_(defensive), representativeCount_(representatives.size()) {
-  auto cosineOf = [](float angle) {
-    const float sinHalf = std::sin(0.5f * std::min(angle, 3.14159265f));
-    return 1.0f - 2.0f * sinHalf * sinHalf;
-  };
-  const float cosDefault = cosineOf(coneAngle);
+  const float chord2Default = chord2FromAngle(coneAngle);
   std::vector<float> mass(kCells, 0.0f);
   std::vector<uint32_t> cells;
   for (const GuideRepresentative& r : representatives) {
@@ -92,7 +92,7 @@ GuideDistribution::GuideDistribution(const std::vector<GuideRepresentative>& rep
     if (!(r.weight > 0.0f) || !std::isfinite(r.weight) || !(len > 0.0f) || !std::isfinite(len)) continue;
     const glm::vec3 d = r.direction / len;
     cells.clear();
-    coneCells(d, r.coneAngle > coneAngle ? cosineOf(r.coneAngle) : cosDefault, cells);
+    CellCentres::get().within(d, r.coneAngle > coneAngle ? chord2FromAngle(r.coneAngle) : chord2Default, cells);
     if (cells.empty()) cells.push_back(uint32_t(cellOf(d)));  // a cone narrower than a cell
     const float share = r.weight / float(cells.size());
     for (uint32_t c : cells) mass[c] += share;

@@ -17,16 +17,15 @@ int GuidedContinuation::cachePoint(const SurfaceHit& hit) {
   if (hit.position != lastPosition_ || hit.shadingNormal != lastNormal_) {
     lastPosition_ = hit.position;
     lastNormal_ = hit.shadingNormal;
-    // The camera ray's hit usually belongs to its pixel's slice: try that cache point first.
     ++vertex_;
     const int maxGuided = field_.settings().guidedVertices;
     if (maxGuided > 0 && vertex_ > maxGuided) {
       lastCachePoint_ = -1;
     } else {
-      lastCachePoint_ = primaryVertex_ ? field_.pixelCachePoint(pixel_, hit.position, hit.shadingNormal) : -1;
+      // The camera ray's hit usually belongs to its pixel's slice: try that cache point first.
+      lastCachePoint_ = vertex_ == 1 ? field_.pixelCachePoint(pixel_, hit.position, hit.shadingNormal) : -1;
       if (lastCachePoint_ < 0) lastCachePoint_ = field_.lookup(hit.position, hit.shadingNormal);
     }
-    primaryVertex_ = false;
   }
   return lastCachePoint_;
 }

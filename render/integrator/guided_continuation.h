@@ -23,7 +23,6 @@ class GuidedContinuation final : public ContinuationSampler {
   void beginPath(uint64_t pixel) override {
     chainsUsedByPath_.clear();
     pixel_ = pixel;
-    primaryVertex_ = true;
     vertex_ = 0;
     lastPosition_ = glm::vec3(NAN);  // a new path's first vertex is always a new vertex
   }
@@ -44,7 +43,6 @@ class GuidedContinuation final : public ContinuationSampler {
   glm::vec3 lastPosition_{NAN}, lastNormal_{NAN};
   int lastCachePoint_ = -1;
   uint64_t pixel_ = 0;
-  bool primaryVertex_ = false;  // the next new vertex is the camera ray's hit
   int vertex_ = 0;              // vertices of this path so far (1: the camera ray's hit)
 };
 

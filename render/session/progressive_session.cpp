@@ -86,24 +86,23 @@ ProgressiveSession::~ProgressiveSession() {
   controller_.join();
 }
 
-void ProgressiveSession::setCamera(const CameraData& camera) {
-  std::lock_guard lock(mutex_);
-  camera_ = camera;
-  Request r = pending_ ? *pending_ : Request{camera, stats_.mode, settings_.width, settings_.height};
-  r.camera = camera;
-  pending_ = std::make_unique<Request>(r);
+void ProgressiveSession::requestRestart() {
+  // The state under mutex_ is always the newest the UI asked for: the request is simply a copy of it.
+  pending_ = std::make_unique<Request>(Request{camera_, stats_.mode, settings_.width, settings_.height});
   cancel_.store(true);
   changed_.notify_all();
 }
 
+void ProgressiveSession::setCamera(const CameraData& camera) {
+  std::lock_guard lock(mutex_);
+  camera_ = camera;
+  requestRestart();
+}
+
 void ProgressiveSession::setMode(SamplingMode mode) {
   std::lock_guard lock(mutex_);
-  Request r = pending_ ? *pending_ : Request{camera_, stats_.mode, settings_.width, settings_.height};
-  r.mode = mode;
   stats_.mode = mode;
-  pending_ = std::make_unique<Request>(r);
-  cancel_.store(true);
-  changed_.notify_all();
+  requestRestart();
 }
 
 void ProgressiveSession::resize(int width, int height) {
@@ -112,12 +111,7 @@ void ProgressiveSession::resize(int width, int height) {
   if (width == settings_.width && height == settings_.height) return;
   settings_.width = width;
   settings_.height = height;
-  Request r = pending_ ? *pending_ : Request{camera_, stats_.mode, width, height};
-  r.width = width;
-  r.height = height;
-  pending_ = std::make_unique<Request>(r);
-  cancel_.store(true);
-  changed_.notify_all();
+  requestRestart();
 }
 
 bool ProgressiveSession::latestImage(Image& out, uint64_t& version, Image* variance) const {

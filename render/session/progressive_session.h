@@ -84,6 +84,7 @@ class ProgressiveSession {
  private:
   struct Request;
   struct CameraState;
+  void requestRestart();  // with mutex_ held: post the current camera, mode and size, cancel the pass
   void controllerLoop();
   void runUntilChanged(CameraState& state, const Request& request);
   void publish(const Image& image, SessionStage stage, int spp, Image variance = {});
