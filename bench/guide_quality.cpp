@@ -3,7 +3,9 @@
 //   g(w) = f(wo, w) cos(w) L_ind(w),   L_ind = what the next vertex reflects (its emission excluded),
 // on a stratified set of directions (L_ind by brdf path tracing), and prints for each strategy the
 // variance of the one-sample estimator g/p relative to BSDF sampling: below 1 the strategy beats
-// the BSDF at equal sample count. Usage:
+// the BSDF at equal sample count. The "oracle" column is the best a tabulated guide could do: g
+// itself, estimated with independent paths, on the same equal-area map and mixed with the BSDF as
+// `mis` is (it bounds what a better target could gain at this vertex). Usage:
 //   guide_quality SCENE [cache points=48] [directions=4096] [paths per direction=8] [width=320] [height=240]
 // Environment overrides of the defaults: GQ_VPLS (count), GQ_CONE (degrees), GQ_DEFENSIVE, GQ_CLAMP, GQ_SPREAD.
 // GQ_DUMP=C prints cache point C and each direction's share of the guide's second moment on stderr.
@@ -25,6 +27,7 @@ namespace {
 
 struct Moments {
   double mean = 0.0, bsdf = 0.0, guide = 0.0, mis = 0.0;  // integral, then second moments E_p[(g/p)^2]
+  double oracle = 0.0;  // an ideal tabulated guide: g itself (from independent paths) on the same map, mixed as mis
 };
 
 // Stratified uniform sphere directions: each carries g and all strategies' pdfs.
@@ -42,6 +45,8 @@ Moments measure(const RenderScene& scene, const PathTracer& tracer, const GuideF
   Moments m;
   const bool dump = std::getenv("GQ_DUMP") && std::atoi(std::getenv("GQ_DUMP")) == c;
   Rng rng(seed, uint64_t(c));
+  struct Sample { glm::vec3 w; double g; float gOracle; };
+  std::vector<Sample> samples;
   BsdfContinuation continuation;
   PathStats stats;
   for (int i = 0; i < side * side; ++i) {
@@ -49,15 +54,18 @@ Moments measure(const RenderScene& scene, const PathTracer& tracer, const GuideF
     const glm::vec3 w = sampleUniformSphere(u);
     const glm::vec3 f = bsdf.eval(wo, w);
     if (isBlack(f) || glm::dot(w, cp.normal) <= 0.0f) continue;
-    glm::vec3 l(0.0f);
+    glm::vec3 l(0.0f), lOracle(0.0f);
     const Ray ray = spawnRay(at, w);
     for (int k = 0; k < paths; ++k) l += tracer.radiance(ray, rng, continuation, stats);
+    for (int k = 0; k < paths; ++k) lOracle += tracer.radiance(ray, rng, continuation, stats);
     const RayHit hit = scene.accel().intersect(ray);
     if (hit.valid()) {
       const SurfaceHit s = scene.surface(ray, hit);
       l -= float(paths) * scene.emitters().emitted(s, -w);  // next-event estimation's share
+      lOracle -= float(paths) * scene.emitters().emitted(s, -w);
     }
     const double g = std::max(0.0f, luminance(f * l)) / paths;
+    samples.push_back({w, g, std::max(0.0f, luminance(f * lOracle)) / float(paths)});
     const double pu = uniformSpherePdf(), pb = bsdf.pdf(wo, w), pg = cp.distribution.pdf(w);
     const double pm = pBsdf * pb + (1.0 - pBsdf) * pg;
     const double n = double(side) * side;
@@ -68,6 +76,14 @@ Moments measure(const RenderScene& scene, const PathTracer& tracer, const GuideF
     if (dump && g > 0)
       std::fprintf(stderr, "w %6.3f %6.3f %6.3f cos %.3f g %.4g pg %.4g pb %.4g g2/pg %.4g\n", w.x, w.y, w.z,
                    glm::dot(w, cp.normal), g, pg, pb, g * g / (pg * pu) / n);
+  }
+  // The oracle is built from the second, independent estimate so that it cannot fit the first one's noise.
+  std::vector<GuideRepresentative> truth;
+  for (const Sample& x : samples) truth.push_back({x.w, x.gOracle, 0.0f});
+  const GuideDistribution oracle(truth, 0.0f, cp.distribution.defensive());
+  for (const Sample& x : samples) {
+    const double pm = pBsdf * bsdf.pdf(wo, x.w) + (1.0 - pBsdf) * oracle.pdf(x.w);
+    m.oracle += x.g * x.g / (pm * uniformSpherePdf()) / (double(side) * side);
   }
   if (dump)
     std::fprintf(stderr, "cache %d at %.3f %.3f %.3f n %.3f %.3f %.3f radius %.3f\n", c, cp.position.x, cp.position.y,
@@ -104,21 +120,24 @@ int main(int argc, char** argv) {
       const uint32_t g = vplField.tree.slices[size_t(c)].representative;
       results[i] = measure(scene, tracer, field, c, vplField.gather.wo[g], directions, paths, 7);
     });
-    std::printf("%5s %10s %10s %10s %10s %6s\n", "cache", "integral", "var guide", "var mis", "(/ var bsdf)", "reps");
-    std::vector<double> guideRatio, misRatio;
+    std::printf("%5s %10s %10s %10s %10s %6s\n", "cache", "integral", "var guide", "var mis", "var oracle", "reps");
+    std::vector<double> guideRatio, misRatio, oracleRatio;
     for (size_t i = 0; i < results.size(); ++i) {
       const Moments& m = results[i];
       const double vb = m.bsdf - m.mean * m.mean, vg = m.guide - m.mean * m.mean, vm = m.mis - m.mean * m.mean;
       if (!(vb > 0)) continue;
       guideRatio.push_back(vg / vb);
       misRatio.push_back(vm / vb);
+      const double vo = m.oracle - m.mean * m.mean;
+      oracleRatio.push_back(vo / vb);
       const int c = int(i * field.size() / results.size());
-      std::printf("%5d %10.4g %10.3f %10.3f %10s %6zu\n", c, m.mean, vg / vb, vm / vb, "", field.point(c).distribution.size());
+      std::printf("%5d %10.4g %10.3f %10.3f %10.3f %6zu\n", c, m.mean, vg / vb, vm / vb, vo / vb, field.point(c).distribution.size());
     }
     auto median = [](std::vector<double> v) { std::sort(v.begin(), v.end()); return v.empty() ? 0.0 : v[v.size() / 2]; };
     auto mean = [](const std::vector<double>& v) { double s = 0; for (double x : v) s += x; return v.empty() ? 0.0 : s / v.size(); };
-    std::printf("variance relative to BSDF sampling: guide median %.3f mean %.3f, mis median %.3f mean %.3f\n",
-                median(guideRatio), mean(guideRatio), median(misRatio), mean(misRatio));
+    std::printf("variance relative to BSDF sampling: guide median %.3f mean %.3f, mis median %.3f mean %.3f, "
+                "oracle mis median %.3f mean %.3f\n", median(guideRatio), mean(guideRatio), median(misRatio),
+                mean(misRatio), median(oracleRatio), mean(oracleRatio));
   } catch (const InputError& e) {
     std::fprintf(stderr, "guide_quality: %s\n", e.what());
     return 2;
