@@ -90,10 +90,12 @@ std::vector<float> readFloats(const tinygltf::Model& model, int index, int expec
   if (uint64_t(a.count) * uint64_t(comps) * 4u > maxBytes)
     throw InputError(where + " claims " + std::to_string(a.count) + " elements, more than the size limit");
 
-  std::vector<float> out(size_t(a.count) * size_t(comps), 0.0f);
+  // The view is checked before the output is allocated: a count the data cannot back costs nothing.
   const size_t elementSize = size_t(comps) * size_t(csize);
+  ViewSpan span;
+  if (a.bufferView >= 0) span = checkedView(model, a.bufferView, a.byteOffset, a.count, elementSize, true, where);
+  std::vector<float> out(size_t(a.count) * size_t(comps), 0.0f);
   if (a.bufferView >= 0) {
-    const ViewSpan span = checkedView(model, a.bufferView, a.byteOffset, a.count, elementSize, true, where);
     for (size_t i = 0; i < a.count; ++i)
       for (int c = 0; c < comps; ++c)
         out[i * comps + size_t(c)] = float(readComponent(span.base + i * span.stride + size_t(c) * csize, a.componentType, a.normalized));
@@ -129,13 +131,14 @@ std::vector<uint32_t> readIndices(const tinygltf::Model& model, int index, const
       a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
     throw InputError(where + " must be unsigned byte, short or int");
   if (uint64_t(a.count) * 4u > maxBytes) throw InputError(where + " claims more elements than the size limit");
-  std::vector<uint32_t> out(a.count, 0u);
+  if (a.sparse.isSparse) throw InputError(where + ": sparse index accessors are not supported");
   const int csize = componentSize(a.componentType);
+  ViewSpan span;
+  if (a.bufferView >= 0) span = checkedView(model, a.bufferView, a.byteOffset, a.count, size_t(csize), false, where);
+  std::vector<uint32_t> out(a.count, 0u);
   if (a.bufferView >= 0) {
-    const ViewSpan span = checkedView(model, a.bufferView, a.byteOffset, a.count, size_t(csize), false, where);
     for (size_t i = 0; i < a.count; ++i) out[i] = uint32_t(readComponent(span.base + i * span.stride, a.componentType, false));
   }
-  if (a.sparse.isSparse) throw InputError(where + ": sparse index accessors are not supported");
   return out;
 }
 

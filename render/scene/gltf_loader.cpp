@@ -48,7 +48,12 @@ bool fileExists(const std::string& path, void* user) {
   auto* ctx = static_cast<LoadContext*>(user);
   fs::path resolved;
   if (!insideRoot(*ctx, path, resolved)) {
-    if (ctx->firstError.empty()) ctx->firstError = "'" + path + "' is outside the scene's folder: refused";
+    // tinygltf probes the scene's folder, then the working directory ("./" + uri). Judge the URI
+    // itself, so a file merely missing from the folder stays tinygltf's "File not found".
+    const std::string uri = path.rfind("./", 0) == 0 ? path.substr(2) : path;
+    fs::path unused;
+    if (ctx->firstError.empty() && (fs::path(uri).is_absolute() || !insideRoot(*ctx, (ctx->root / uri).string(), unused)))
+      ctx->firstError = "'" + path + "' is outside the scene's folder: refused";
     return false;
   }
   std::error_code ec;

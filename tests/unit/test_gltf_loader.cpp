@@ -1,8 +1,10 @@
 // The glTF loader on real files: the public sample scenes, the built-in scenes, and broken files.
 #include <cstring>
 #include <filesystem>
-#include <unistd.h>
 #include <fstream>
+#include <sys/resource.h>
+#include <unistd.h>
+#include <stb_image_write.h>
 #include "render/core/error.h"
 #include "render/scene/gltf_loader.h"
 #include "tests/unit/support.h"
@@ -199,6 +201,68 @@ TEST_F(BrokenFile, UnknownRequiredExtension) {
 }
 
 TEST_F(BrokenFile, GarbageGlb) { expectError(write("g.glb", "glTF\x02\0\0\0garbage"), ""); }
+
+// Peak resident memory of this process so far, in MB.
+double peakRssMb() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return u.ru_maxrss / 1024.0;
+}
+
+TEST_F(BrokenFile, AccessorClaimUnderTheLimitButBeyondItsDataIsRefusedBeforeAllocating) {
+  // 125M VEC3 floats = 1.5 GB: under the default 2 GiB limit, but its bufferView holds 36 bytes.
+  const std::string data = "data:application/octet-stream;base64," + base64(floats({0, 0, 0, 1, 0, 0, 0, 1, 0}));
+  const double before = peakRssMb();
+  expectError(write("b.gltf", triangleGltf(data, 36, 125'000'000)), "do not fit");
+  EXPECT_LT(peakRssMb() - before, 256.0) << "the accessor's 1.5 GB were allocated before the check";
+}
+
+// A PNG signature and IHDR chunk saying w x h RGBA (stb_image skips the CRC), and no pixels.
+std::string pngHeader(uint32_t w, uint32_t h) {
+  std::string png = "\x89PNG\r\n\x1a\n" + std::string("\0\0\0\x0d", 4) + "IHDR";
+  for (uint32_t v : {w, h})
+    for (int shift = 24; shift >= 0; shift -= 8) png += char((v >> shift) & 0xff);
+  return png + std::string("\x08\x06\0\0\0", 5) + "CRC!";
+}
+
+TEST_F(BrokenFile, ImageHeadersClaimingTooManyPixelsAreRefusedBeforeDecoding) {
+  const std::string data = "data:application/octet-stream;base64," + base64(floats({0, 0, 0, 1, 0, 0, 0, 1, 0}));
+  auto withImage = [&](uint32_t w, uint32_t h) {
+    return triangleGltf(data, 36, 3, R"(,"images":[{"uri":"data:image/png;base64,)" + base64(pngHeader(w, h)) + R"("}])");
+  };
+  // 100000^2 RGBA is past stb_image's own 1 GiB header check; 16384^2 passes it and meets the
+  // loader's limit (64 Mpixels by default).
+  expectError(write("i.gltf", withImage(100000, 100000)), "image 0 is not a decodable PNG/JPEG");
+  expectError(write("j.gltf", withImage(16384, 16384)), "image 0 claims 16384x16384 pixels, more than the limit");
+}
+
+TEST_F(BrokenFile, UrlEncodedUriEscapingTheSceneFolderIsRefused) {
+  std::ofstream(dir / "outside.bin", std::ios::binary) << floats({0, 0, 0, 1, 0, 0, 0, 1, 0});
+  expectError(write("p.gltf", triangleGltf("%2e%2e/outside.bin", 36, 3)), "outside the scene's folder");
+  expectError(write("q.gltf", triangleGltf("%2E%2E%2Foutside.bin", 36, 3)), "outside the scene's folder");
+}
+
+TEST_F(BrokenFile, MissingBufferIsNotFoundRatherThanRefused) {
+  // tinygltf also looks for it in the working directory; that probe must not turn into "refused".
+  expectError(write("m.gltf", triangleGltf("absent.bin", 36, 3)), "not found");
+}
+
+TEST_F(BrokenFile, DataUriImageIsDecodedIntoATexture) {
+  const unsigned char rgba[16] = {255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 255, 255, 255, 255};
+  std::string png;
+  stbi_write_png_to_func([](void* out, void* bytes, int n) { static_cast<std::string*>(out)->append(static_cast<char*>(bytes), size_t(n)); },
+                         &png, 2, 2, 4, rgba, 8);
+  const std::string data = "data:application/octet-stream;base64," + base64(floats({0, 0, 0, 1, 0, 0, 0, 1, 0}));
+  std::string gltf = triangleGltf(data, 36, 3, R"(,"materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0}}}],)"
+                                               R"("textures":[{"source":0}],"images":[{"uri":"data:image/png;base64,)" + base64(png) + R"("}])");
+  gltf.replace(gltf.find(R"({"POSITION":0})"), 14, R"({"POSITION":0},"material":0)");
+  const SceneData s = loadGltf(write("d.gltf", gltf));
+  ASSERT_EQ(s.textures.size(), 1u);
+  ASSERT_EQ(s.textures[0].texels.size(), 4u);
+  const glm::vec4 red = s.textures[0].texels[0], white = s.textures[0].texels[3];  // sRGB 255, 0: linear 1, 0
+  EXPECT_LT(glm::length(red - glm::vec4(1, 0, 0, 1)) + glm::length(white - glm::vec4(1)), 1e-5f);
+  EXPECT_EQ(s.materials[s.meshes[0].material].baseColorTexture, 0);
+}
 
 }  // namespace
 }  // namespace vpl
