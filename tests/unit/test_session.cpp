@@ -174,5 +174,33 @@ TEST(Session, ResizeRestartsAtTheNewSize) {
   EXPECT_EQ(image.height, 10);
 }
 
+TEST(Session, StillRendersAfterAThousandRapidCameraAndModeChanges) {
+  // The viewer's worst case (bench/session_latency does it at window size): changes posted back to
+  // back, faster than any stage can finish. Under the ASan suite, LeakSanitizer also checks that
+  // none of the thousand cut-short restarts leaves memory behind.
+  const auto scene = cornell();
+  const CameraData start = defaultCamera(scene->data());
+  ProgressiveSession session(scene, start, small(SamplingMode::Mis, 2));
+  Image image;
+  uint64_t version = 0;
+  session.latestImage(image, version);
+  const uint64_t before = version;
+  CameraData c = start;
+  SamplingMode mode = SamplingMode::Mis;
+  for (int i = 0; i < 1000; ++i) {
+    c.eye += glm::vec3(0.0f, 1e-3f * scene->radius(), 0.0f);
+    if (i % 3 == 0) session.setMode(mode = (i % 2 ? SamplingMode::Brdf : SamplingMode::Mis));
+    session.setCamera(c);
+  }
+  // No deadlock: the last view renders to the end, and it is that view's fresh image.
+  ASSERT_TRUE(session.waitUntilDone(120.0));
+  ASSERT_TRUE(session.latestImage(image, version));
+  EXPECT_GT(version, before);
+  EXPECT_EQ(session.stats().stage, SessionStage::Done);
+  EXPECT_EQ(session.stats().mode, mode);
+  ProgressiveSession fresh(scene, c, small(mode, 2));
+  EXPECT_EQ(relMse(image, finalImage(fresh)), 0.0);
+}
+
 }  // namespace
 }  // namespace vpl
