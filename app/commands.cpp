@@ -13,6 +13,7 @@
 #include "render/session/render_job.h"
 #include "render/session/ray_benchmark.h"
 #include "app/converge.h"
+#include "app/sweep.h"
 #include "app/render_options.h"
 #include "ui/osmesa_capture.h"
 #include "ui/viewer.h"
@@ -21,11 +22,13 @@ namespace vpl::app {
 
 namespace {
 
-RenderOptions gRender, gBench, gCapture, gReference, gConverge;
+RenderOptions gRender, gBench, gCapture, gReference, gConverge, gSweep;
 ConvergeOptions gConvergeOnly;
+SweepOptions gSweepOnly;
 constexpr uint64_t kReferenceSeed = 1000;
 CLI::App* gReferenceCommand = nullptr;
 CLI::App* gConvergeCommand = nullptr;
+CLI::App* gSweepCommand = nullptr;
 CLI::App* gRenderCommand = nullptr;
 CLI::App* gCaptureCommand = nullptr;
 RenderOptions gViewer;  // the viewer reuses the mode, size, seed, thread, exposure and VPL/guide flags
@@ -173,6 +176,11 @@ void registerCommands(CLI::App& app) {
   gConverge.addConvergeTo(*gConvergeCommand);
   gConvergeOnly.addTo(*gConvergeCommand);
 
+  gSweepCommand = app.add_subcommand("sweep", "equal-time relMSE of each value of one or more render flags against a reference");
+  gSweepCommand->footer("example: vplview sweep SCENE --reference REF.exr --modes mis --times 10 --vary --clusters=50,100,200,400");
+  gSweep.addConvergeTo(*gSweepCommand);
+  gSweepOnly.addTo(*gSweepCommand);
+
   gCaptureCommand = app.add_subcommand("capture", "render headlessly and save what the viewer's display would show (OSMesa)");
   gCapture.addTo(*gCaptureCommand, /*requireOut=*/true);
 
@@ -208,6 +216,7 @@ int runSelectedCommand(CLI::App& app) {
     return runRender(gReference, SamplingMode::Brdf);
   }
   if (gConvergeCommand->parsed()) return runConverge(gConvergeOnly, gConverge, *gConvergeCommand);
+  if (gSweepCommand->parsed()) return runSweep(gSweepOnly, gSweep, *gSweepCommand);
   if (gBenchCommand->parsed()) return runBench();
   if (gCaptureCommand->parsed()) return runCapture();
   (void)app;

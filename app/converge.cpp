@@ -3,7 +3,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <unistd.h>
 #include <nlohmann/json.hpp>
 #include <tbb/global_control.h>
@@ -12,44 +11,30 @@
 #include "render/film/image_metrics.h"
 #include "render/film/plot.h"
 #include "render/session/render_job.h"
+#include "app/list_options.h"
 
 namespace vpl::app {
 
-namespace {
-
-std::vector<std::string> splitCommas(const std::string& list) {
-  std::vector<std::string> items;
-  std::stringstream in(list);
-  for (std::string item; std::getline(in, item, ',');)
-    if (!item.empty()) items.push_back(item);
-  return items;
+void matchReferenceSize(RenderJobSettings& settings, const Image& reference, const std::string& referencePath,
+                        const CLI::App& command) {
+  const bool sizeGiven = command.count("--width") > 0 || command.count("--height") > 0;
+  if (sizeGiven && (settings.width != reference.width || settings.height != reference.height))
+    throw InputError(referencePath + ": the reference is " + std::to_string(reference.width) + "x" +
+                     std::to_string(reference.height) + ", not the requested size");
+  settings.width = reference.width;
+  settings.height = reference.height;
 }
 
-std::vector<SamplingMode> parseModes(const std::string& list) {
-  std::vector<SamplingMode> modes;
-  for (const std::string& name : splitCommas(list)) {
-    const auto mode = parseMode(name);
-    if (!mode) throw InputError("--modes: unknown mode '" + name + "' (brdf, metropolis, mis, mixture, preview)");
-    modes.push_back(*mode);
+std::vector<std::string> prepareOutputs(const std::string& dir, std::initializer_list<const char*> names) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  std::vector<std::string> paths;
+  for (const char* name : names) {
+    paths.push_back(dir + "/" + name);
+    checkWritable(paths.back());
   }
-  if (modes.empty()) throw InputError("--modes: no mode given");
-  return modes;
+  return paths;
 }
-
-std::vector<double> parseTimes(const std::string& list) {
-  std::vector<double> times;
-  for (const std::string& item : splitCommas(list)) {
-    char* end = nullptr;
-    const double t = std::strtod(item.c_str(), &end);
-    if (end == item.c_str() || *end != '\0' || !(t > 0.0) || !(t < 1e6))
-      throw InputError("--times: '" + item + "' is not a positive number of seconds");
-    times.push_back(t);
-  }
-  if (times.empty()) throw InputError("--times: no budget given");
-  return times;
-}
-
-}  // namespace
 
 void ConvergeOptions::addTo(CLI::App& command) {
   command.add_option("--reference", reference, "reference image (OpenEXR, e.g. from 'vplview reference')")->required();
@@ -63,17 +48,9 @@ int runConverge(const ConvergeOptions& converge, const RenderOptions& render, co
   const std::vector<double> times = parseTimes(converge.times);
   const Image reference = readExr(converge.reference);
   RenderJobSettings settings = render.toSettings();
-  const bool sizeGiven = command.count("--width") > 0 || command.count("--height") > 0;
-  if (sizeGiven && (settings.width != reference.width || settings.height != reference.height))
-    throw InputError(converge.reference + ": the reference is " + std::to_string(reference.width) + "x" +
-                     std::to_string(reference.height) + ", not the requested size");
-  settings.width = reference.width;
-  settings.height = reference.height;
-  std::error_code ec;
-  std::filesystem::create_directories(converge.outDir, ec);
-  const std::string csvPath = converge.outDir + "/converge.csv", plotPath = converge.outDir + "/converge.png";
-  checkWritable(csvPath);
-  checkWritable(plotPath);
+  matchReferenceSize(settings, reference, converge.reference, command);
+  const auto paths = prepareOutputs(converge.outDir, {"converge.csv", "converge.png"});
+  const std::string &csvPath = paths[0], &plotPath = paths[1];
   tbb::global_control threads(tbb::global_control::max_allowed_parallelism, render.threadCount());
 
   std::ofstream csv(csvPath);
