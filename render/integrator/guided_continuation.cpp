@@ -30,9 +30,16 @@ int GuidedContinuation::cachePoint(const SurfaceHit& hit) {
   return lastCachePoint_;
 }
 
+int GuidedContinuation::servingCachePoint(const SurfaceHit& hit, const Bsdf& bsdf) {
+  const int c = cachePoint(hit);  // always asked, so the vertex count stays right
+  // A lobe a few degrees wide is found only by sampling it: no tabulated guide can (a mirror under
+  // a sky came out 20x too dark in the guide-only modes before this).
+  return bsdf.isNearSpecular() ? -1 : c;
+}
+
 bool GuidedContinuation::sample(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, Rng& rng,
                                 DirectionSample& out, PathStats& stats) {
-  const int c = cachePoint(hit);
+  const int c = servingCachePoint(hit, bsdf);
   const float pBsdf = c < 0 ? 1.0f : bsdfProbability();
   const float uStrategy = rng.uniform();
   if (uStrategy < pBsdf) {
@@ -62,7 +69,7 @@ bool GuidedContinuation::sample(const SurfaceHit& hit, const Bsdf& bsdf, const g
 }
 
 float GuidedContinuation::pdf(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, const glm::vec3& wi) {
-  const int c = cachePoint(hit);
+  const int c = servingCachePoint(hit, bsdf);
   if (c < 0) return bsdf.pdf(wo, wi);
   const float pBsdf = bsdfProbability();
   const float guidePdf = field_.point(c).distribution.pdf(wi);

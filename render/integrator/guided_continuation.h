@@ -2,7 +2,8 @@
 //   metropolis  the cache point's Markov chain alone
 //   mixture     exact samples of the same target (representative by weight, then its cone)
 //   mis         one-sample MIS of the BSDF and the Markov chain, balance heuristic with both pdfs
-// A vertex with no cache point nearby (distance or normal test) samples its BSDF. One object per
+// A vertex with no cache point nearby (distance or normal test), or with a near-specular BSDF,
+// samples its BSDF. One object per
 // tile and pass: its chains restart from exact samples, so results do not depend on scheduling.
 #pragma once
 #include <unordered_map>
@@ -32,6 +33,8 @@ class GuidedContinuation final : public ContinuationSampler {
   float bsdfProbability() const;
   // The cache point of a vertex; sample() and pdf() ask for the same vertex in a row, so remember it.
   int cachePoint(const SurfaceHit& hit);
+  // The cache point that guides this vertex: none for a near-specular BSDF.
+  int servingCachePoint(const SurfaceHit& hit, const Bsdf& bsdf);
 
   const GuideField& field_;
   SamplingMode mode_;

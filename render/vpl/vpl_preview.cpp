@@ -79,6 +79,47 @@ VplField buildVplField(const RenderScene& scene, const Camera& camera, std::shar
   return field;
 }
 
+namespace {
+
+// One emitter sample, unweighted: the preview has no BSDF-sampled light to combine it with.
+glm::vec3 directLight(const RenderScene& scene, const SurfaceHit& surface, const Bsdf& bsdf, const glm::vec3& wo, Rng& rng,
+                      PathStats& stats) {
+  const auto ls = scene.emitters().sample(surface.position, rng.uniform(), rng.uniform2());
+  if (!ls) return glm::vec3(0.0f);
+  const glm::vec3 f = bsdf.eval(wo, ls->wi);
+  if (isBlack(f) || glm::dot(ls->wi, surface.geometricNormal) <= 0.0f) return glm::vec3(0.0f);
+  ++stats.rays;
+  return scene.accel().occluded(spawnShadowRay(surface, ls->wi, ls->distance)) ? glm::vec3(0.0f) : f * ls->radiance / ls->pdf;
+}
+
+// What a near-specular surface shows: its BSDF followed (a few bounces) to the first rough surface,
+// which gets emission and direct light (light sampling alone cannot find a lobe a few degrees wide,
+// and VPLs would light it in spikes).
+glm::vec3 reflectedLight(const RenderScene& scene, SurfaceHit surface, Bsdf bsdf, glm::vec3 wo, Rng& rng,
+                         PathStats& stats) {
+  constexpr int kSpecularBounces = 8;
+  const EmitterSet& emitters = scene.emitters();
+  glm::vec3 L(0.0f), beta(1.0f);
+  for (int bounce = 0; bounce < kSpecularBounces; ++bounce) {
+    const float uLobe = rng.uniform();
+    const auto next = bsdf.sample(wo, rng.uniform2(), uLobe);
+    if (!next || glm::dot(next->wi, surface.geometricNormal) <= 0.0f) break;
+    beta *= next->weight;
+    const Ray ray = spawnRay(surface, next->wi);
+    const RayHit hit = scene.accel().intersect(ray);
+    ++stats.rays;
+    if (!hit.valid()) return L + (emitters.hasSky() ? beta * emitters.sky() : glm::vec3(0.0f));
+    surface = scene.surface(ray, hit);
+    wo = -ray.direction;
+    L += beta * emitters.emitted(surface, wo);
+    bsdf = scene.bsdf(surface);
+    if (!bsdf.isNearSpecular()) return L + beta * directLight(scene, surface, bsdf, wo, rng, stats);
+  }
+  return L;
+}
+
+}  // namespace
+
 PixelShaderFactory previewShader(const RenderScene& scene, const VplField& field, const PreviewSettings& settings) {
   const int m = settings.clustersPerPass;
   return [&scene, &field, m](uint32_t, uint64_t) -> PixelShader {
@@ -91,15 +132,8 @@ PixelShaderFactory previewShader(const RenderScene& scene, const VplField& field
       const glm::vec3 wo = -ray.direction;
       glm::vec3 L = emitters.emitted(surface, wo);
       const Bsdf bsdf = scene.bsdf(surface);
-
-      // Direct light: one emitter sample.
-      if (const auto ls = emitters.sample(surface.position, rng.uniform(), rng.uniform2())) {
-        const glm::vec3 f = bsdf.eval(wo, ls->wi);
-        if (!isBlack(f) && glm::dot(ls->wi, surface.geometricNormal) > 0.0f) {
-          ++stats.rays;
-          if (!scene.accel().occluded(spawnShadowRay(surface, ls->wi, ls->distance))) L += f * ls->radiance / ls->pdf;
-        }
-      }
+      if (bsdf.isNearSpecular()) return L + reflectedLight(scene, surface, bsdf, wo, rng, stats);
+      L += directLight(scene, surface, bsdf, wo, rng, stats);
 
       // Indirect light: clusters of the pixel's slice, sampled by estimated contribution.
       const int32_t g = pixel < field.gather.pixelGather.size() ? field.gather.pixelGather[pixel] : -1;

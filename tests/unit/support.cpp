@@ -198,6 +198,15 @@ ChiSquareResult chiSquareEqualArea(const std::function<glm::vec3()>& sample,
   });
 }
 
+void setPreviewBudgetsToOne(RenderJobSettings& s) {
+  s.preview.clustering.globalClusters = 1;
+  s.preview.clustering.clusterBudget = 1;
+  s.preview.clustering.reducedRows = 1;
+  s.preview.clustering.refinementRows = 1;
+  s.preview.slices.maxSliceSize = 1;
+  s.preview.clustersPerPass = 1;
+}
+
 std::string sourceDir() { return VPLVIEW_SOURCE_DIR; }
 std::string sharedDir() { return VPLVIEW_SHARED_DIR; }
 

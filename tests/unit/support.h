@@ -5,6 +5,7 @@
 #include <string>
 #include <glm/glm.hpp>
 #include <gtest/gtest.h>
+#include "render/session/render_job.h"
 
 namespace vpl::test {
 
@@ -40,6 +41,9 @@ double integrateSphere(const std::function<double(const glm::vec3&)>& f, int cos
 
 // Upper tail of the chi-square distribution: P(X >= statistic) with dof degrees of freedom.
 double chiSquareTail(double statistic, int dof);
+
+// Every clustering, slice and per-pass budget of the preview at its minimum, 1 (DESIGN.md §5).
+void setPreviewBudgetsToOne(RenderJobSettings& settings);
 
 std::string sourceDir();
 std::string sharedDir();

@@ -55,12 +55,7 @@ TEST(Preview, OneVplAndBudgetOneStayFinite) {
   s.preview.vpl.count = 1;
   EXPECT_TRUE(allFinite(runRenderJob(s).image));
   s.preview.vpl.count = 4096;
-  s.preview.clustering.globalClusters = 1;
-  s.preview.clustering.clusterBudget = 1;
-  s.preview.clustering.reducedRows = 1;
-  s.preview.clustering.refinementRows = 1;
-  s.preview.slices.maxSliceSize = 1;
-  s.preview.clustersPerPass = 1;
+  test::setPreviewBudgetsToOne(s);
   const RenderJobResult r = runRenderJob(s);
   EXPECT_TRUE(allFinite(r.image));
   EXPECT_DOUBLE_EQ(r.clustersPerSlice, 1.0);
