@@ -184,12 +184,22 @@ class SceneBuilder {
       throw InputError(file_ + ": node " + std::to_string(index) + " does not exist");
     if (depth > 1024 || std::find(onPath.begin(), onPath.end(), index) != onPath.end())
       throw InputError(file_ + ": the node hierarchy has a cycle at node " + std::to_string(index));
+    // Children may be shared, so a few nodes can stand for exponentially many instances.
+    if (++visits_ > limits_.maxNodeVisits)
+      throw InputError(file_ + ": the node hierarchy makes more than " + std::to_string(limits_.maxNodeVisits) +
+                       " node instances, the limit");
     const tinygltf::Node& node = model_.nodes[size_t(index)];
     const glm::mat4 world = parent * localTransform(node);
     if (node.mesh >= 0) addMesh(node.mesh, world);
     if (node.camera >= 0 && !scene_.camera) addCamera(node.camera, world);
-    if (auto it = node.extensions.find("KHR_lights_punctual"); it != node.extensions.end() && it->second.Has("light"))
-      addLight(it->second.Get("light").GetNumberAsInt(), world);
+    if (auto it = node.extensions.find("KHR_lights_punctual"); it != node.extensions.end() && it->second.Has("light")) {
+      // Not GetNumberAsInt: it casts any double to int unchecked (undefined behaviour past INT_MAX).
+      const tinygltf::Value& light = it->second.Get("light");
+      const double lightIndex = light.IsNumber() ? light.GetNumberAsDouble() : -1.0;
+      if (!(lightIndex >= 0.0 && lightIndex < double(model_.lights.size())))
+        throw InputError(file_ + ": node " + std::to_string(index) + " refers to a light that does not exist");
+      addLight(int(lightIndex), world);
+    }
     onPath.push_back(index);
     for (int c : node.children) visit(c, world, onPath, depth + 1);
     onPath.pop_back();
@@ -355,7 +365,7 @@ class SceneBuilder {
   SceneData scene_;
   gltf::MaterialConverter materials_;
   size_t degenerate_ = 0;
-  uint64_t triangles_ = 0;
+  uint64_t triangles_ = 0, visits_ = 0;
 };
 
 }  // namespace

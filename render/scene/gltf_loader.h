@@ -12,6 +12,7 @@ struct LoadLimits {
   uint64_t maxBufferBytes = 2ull << 30;   // per buffer or external file
   uint64_t maxImagePixels = 64ull << 20;  // per decoded image
   uint64_t maxTriangles = 100'000'000;    // whole scene
+  uint64_t maxNodeVisits = 1'000'000;     // node instances after flattening (shared children multiply)
 };
 
 SceneData loadGltf(const std::filesystem::path& file, const LoadLimits& limits = {});

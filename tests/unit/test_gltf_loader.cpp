@@ -98,6 +98,22 @@ TEST(GltfLoader, BuiltInScenesHaveCamerasAndLights) {
   }
 }
 
+// Inputs that once crashed, hung or tripped a sanitizer in fuzz/fuzz_gltf_loader (fuzz/regressions/,
+// see fuzz/README.md): each is refused now, with the default limits too.
+TEST(GltfLoader, FuzzRegressionsAreRefusedWithAnInputError) {
+  int count = 0;
+  for (const auto& entry : fs::directory_iterator(test::sourceDir() + "/fuzz/regressions")) {
+    ++count;
+    try {
+      loadGltf(entry.path());
+      ADD_FAILURE() << entry.path() << " loaded but should not";
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_GT(count, 0);
+}
+
 // Broken files: one-line InputError naming the file, never a crash.
 class BrokenFile : public ::testing::Test {
  protected:
