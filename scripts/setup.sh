@@ -8,7 +8,8 @@ build=${VPLVIEW_BUILD:-$here/build}
 packages=(build-essential cmake ninja-build pkg-config ccache python3
   libembree-dev libglfw3-dev libosmesa6-dev libglm-dev libtinygltf-dev libopenexr-dev
   libtbb-dev libnanoflann-dev libimgui-dev libcli11-dev libstb-dev libgtest-dev
-  libbenchmark-dev nlohmann-json3-dev xvfb xauth libgl1-mesa-dri)
+  libbenchmark-dev nlohmann-json3-dev xvfb xauth libgl1-mesa-dri
+  clang libclang-rt-14-dev)  # clang + its libFuzzer runtime (only Recommended by clang-14): the fuzz test
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
