@@ -10,8 +10,8 @@
 //   clustering.*                        see LightSliceSettings
 //   clampFraction        float  0.03   geometry-term clamp: 1/d^2 <= 1/(clampFraction x scene diagonal)^2
 //                                       (`vplview sweep`, 3 seeds, 2 s, 1 thread: against 0.01 the preview's relMSE
-//                                       is 0.85x on the Cornell box, 0.24x on two_rooms, 0.97x on the interior, its
-//                                       bias 1-2 points darker; `mis` at 10 s unchanged, 0.99x and 1.01x)
+//                                       is 0.85x on the Cornell box, 0.24x on two_rooms, 0.96x on the interior, its
+//                                       bias 0.2-1.8 points darker; `mis` at 10 s unchanged, 0.99x and 1.01x)
 //   clustersPerPass      int    16     clusters sampled per pixel and pass
 #pragma once
 #include <memory>
