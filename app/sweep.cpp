@@ -30,6 +30,10 @@ Variation parseVariation(const std::string& text) {
   }
   if (v.flag.size() < 3 || v.flag.rfind("--", 0) != 0 || v.values.empty())
     throw InputError("--vary: '" + text + "' is not --FLAG=VALUE1,VALUE2,...");
+  // The sweep sets these itself: a varied value would be silently overwritten.
+  for (const char* owned : {"--mode", "--width", "--height", "--threads"})
+    if (v.flag == owned)
+      throw InputError("--vary: " + v.flag + " is set by the sweep itself (use --modes, the reference's size, --threads)");
   return v;
 }
 

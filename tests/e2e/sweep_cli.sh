@@ -30,6 +30,8 @@ bad sweep "$scene" --reference "$tmp/ref.exr" --vary --clusters=abc --out-dir "$
 bad sweep "$scene" --reference "$tmp/ref.exr" --vary --no-such-flag=1 --out-dir "$tmp/x"
 bad sweep "$scene" --reference "$tmp/ref.exr" --vary clusters --out-dir "$tmp/x"
 bad sweep "$scene" --reference "$tmp/ref.exr" --vary --clusters= --out-dir "$tmp/x"
+bad sweep "$scene" --reference "$tmp/ref.exr" --vary --mode=brdf --out-dir "$tmp/x"
+bad sweep "$scene" --reference "$tmp/ref.exr" --vary --threads=1,2 --out-dir "$tmp/x"
 bad sweep "$scene" --reference "$tmp/missing.exr" --vary --clusters=5 --out-dir "$tmp/x"
 bad sweep "$scene" --reference "$tmp/ref.exr" --vary --clusters=5 --width 41 --out-dir "$tmp/x"
 echo "ok: sweep"
