@@ -4,37 +4,14 @@
 #include <filesystem>
 #include <fstream>
 #include <unistd.h>
-#include <nlohmann/json.hpp>
 #include <tbb/global_control.h>
 #include "render/core/error.h"
 #include "render/film/image_io.h"
-#include "render/film/image_metrics.h"
 #include "render/film/plot.h"
-#include "render/session/render_job.h"
 #include "app/list_options.h"
+#include "app/measurement.h"
 
 namespace vpl::app {
-
-void matchReferenceSize(RenderJobSettings& settings, const Image& reference, const std::string& referencePath,
-                        const CLI::App& command) {
-  const bool sizeGiven = command.count("--width") > 0 || command.count("--height") > 0;
-  if (sizeGiven && (settings.width != reference.width || settings.height != reference.height))
-    throw InputError(referencePath + ": the reference is " + std::to_string(reference.width) + "x" +
-                     std::to_string(reference.height) + ", not the requested size");
-  settings.width = reference.width;
-  settings.height = reference.height;
-}
-
-std::vector<std::string> prepareOutputs(const std::string& dir, std::initializer_list<const char*> names) {
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  std::vector<std::string> paths;
-  for (const char* name : names) {
-    paths.push_back(dir + "/" + name);
-    checkWritable(paths.back());
-  }
-  return paths;
-}
 
 void ConvergeOptions::addTo(CLI::App& command) {
   command.add_option("--reference", reference, "reference image (OpenEXR, e.g. from 'vplview reference')")->required();
@@ -62,15 +39,13 @@ int runConverge(const ConvergeOptions& converge, const RenderOptions& render, co
     for (double budget : times) {
       settings.mode = mode;
       settings.timeBudget = budget;
-      const RenderJobResult result = runRenderJob(settings);
-      const double error = relMse(result.image, reference), bias = relativeBias(result.image, reference);
-      csv << modeName(mode) << ',' << budget << ',' << result.seconds << ',' << result.spp << ',' << error << ',' << bias
-          << '\n';
-      line.x.push_back(result.seconds);
-      line.y.push_back(error);
+      const Measurement m = measureAgainst(settings, reference);
+      csv << modeName(mode) << ',' << budget << ',' << m.seconds << ',' << m.spp << ',' << m.relmse << ',' << m.bias << '\n';
+      line.x.push_back(m.seconds);
+      line.y.push_back(m.relmse);
       if (terminal)
-        std::fprintf(stderr, "converge: %-10s %6.2f s  %5d spp  relMSE %.4g  bias %+.4f\n", modeName(mode), result.seconds,
-                     result.spp, error, bias);
+        std::fprintf(stderr, "converge: %-10s %6.2f s  %5d spp  relMSE %.4g  bias %+.4f\n", modeName(mode), m.seconds, m.spp,
+                     m.relmse, m.bias);
     }
     series.push_back(std::move(line));
   }
@@ -81,13 +56,7 @@ int runConverge(const ConvergeOptions& converge, const RenderOptions& render, co
   const PlotPixels plot = plotLogLog(series, title, "seconds (preprocessing included)", "relMSE");
   writePngBytes(plotPath, plot.width, plot.height, plot.rgb);
 
-  nlohmann::ordered_json j;
-  j["command"] = "converge";
-  j["scene"] = settings.scenePath;
-  j["reference"] = converge.reference;
-  j["width"] = settings.width;
-  j["height"] = settings.height;
-  j["runs"] = modes.size() * times.size();
+  nlohmann::ordered_json j = measurementSummary("converge", settings, converge.reference, modes.size() * times.size());
   j["csv"] = csvPath;
   j["plot"] = plotPath;
   std::printf("%s\n", j.dump().c_str());

@@ -3,14 +3,11 @@
 #include <cstdio>
 #include <fstream>
 #include <unistd.h>
-#include <nlohmann/json.hpp>
 #include <tbb/global_control.h>
-#include "app/converge.h"
 #include "app/list_options.h"
+#include "app/measurement.h"
 #include "render/core/error.h"
 #include "render/film/image_io.h"
-#include "render/film/image_metrics.h"
-#include "render/session/render_job.h"
 
 namespace vpl::app {
 
@@ -49,25 +46,6 @@ RenderOptions withFlag(const RenderOptions& base, const std::string& flag, const
     throw InputError("--vary " + flag + "=" + value + ": " + e.what());
   }
   return options;
-}
-
-struct Outcome {
-  double seconds = 0.0, relmse = 0.0, bias = 0.0;
-  int spp = 0;
-};
-
-Outcome measure(RenderJobSettings settings, const Image& reference, int repeats) {
-  Outcome o;
-  for (int r = 0; r < repeats; ++r) {
-    const RenderJobResult result = runRenderJob(settings);
-    o.seconds += result.seconds / repeats;
-    o.spp += result.spp;
-    o.relmse += relMse(result.image, reference) / repeats;
-    o.bias += relativeBias(result.image, reference) / repeats;
-    ++settings.seed;
-  }
-  o.spp /= repeats;
-  return o;
 }
 
 }  // namespace
@@ -109,7 +87,7 @@ int runSweep(const SweepOptions& sweep, const RenderOptions& render, const CLI::
   const bool terminal = isatty(STDERR_FILENO) != 0;
   size_t runs = 0;
   auto report = [&](const std::string& parameter, const std::string& value, SamplingMode mode, double budget,
-                    const Outcome& o, double baseline) {
+                    const Measurement& o, double baseline) {
     csv << parameter << ',' << value << ',' << modeName(mode) << ',' << budget << ',' << o.seconds << ',' << o.spp << ','
         << o.relmse << ',' << o.bias << '\n';
     char line[256];
@@ -124,14 +102,14 @@ int runSweep(const SweepOptions& sweep, const RenderOptions& render, const CLI::
       RenderJobSettings base = defaults;
       base.mode = mode;
       base.timeBudget = budget;
-      const Outcome baseline = measure(base, reference, sweep.repeats);
+      const Measurement baseline = measureAgainst(base, reference, sweep.repeats);
       report("defaults", "-", mode, budget, baseline, baseline.relmse);
       for (size_t v = 0; v < variations.size(); ++v)
         for (size_t i = 0; i < settings[v].size(); ++i) {
           RenderJobSettings s = settings[v][i];
           s.mode = mode;
           s.timeBudget = budget;
-          report(variations[v].flag, variations[v].values[i], mode, budget, measure(s, reference, sweep.repeats),
+          report(variations[v].flag, variations[v].values[i], mode, budget, measureAgainst(s, reference, sweep.repeats),
                  baseline.relmse);
         }
     }
@@ -139,13 +117,7 @@ int runSweep(const SweepOptions& sweep, const RenderOptions& render, const CLI::
   table.close();
   if (!csv || !table) throw InputError(sweep.outDir + ": cannot write the sweep's files");
 
-  nlohmann::ordered_json j;
-  j["command"] = "sweep";
-  j["scene"] = defaults.scenePath;
-  j["reference"] = sweep.reference;
-  j["width"] = defaults.width;
-  j["height"] = defaults.height;
-  j["runs"] = runs * size_t(sweep.repeats);
+  nlohmann::ordered_json j = measurementSummary("sweep", defaults, sweep.reference, runs * size_t(sweep.repeats));
   j["csv"] = csvPath;
   j["table"] = tablePath;
   std::printf("%s\n", j.dump().c_str());

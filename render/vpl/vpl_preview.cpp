@@ -49,38 +49,6 @@ class SliceTransport final : public LightTransport {
   std::vector<Bsdf> bsdfs_;
 };
 
-}  // namespace
-
-VplField buildVplField(const RenderScene& scene, const Camera& camera, std::shared_ptr<const VplSet> vpls,
-                       const PreviewSettings& settings, const std::atomic<bool>* cancel) {
-  VplField field;
-  field.vpls = std::move(vpls);
-  field.gather = gatherPrimaryHits(scene, camera);
-  const float diagonal = 2.0f * scene.radius();
-  field.tree = buildSliceTree(field.gather.points, settings.slices, diagonal);
-  field.minDistance = settings.clampFraction * diagonal;
-  const SliceTransport transport(scene, field);
-  field.clusters = clusterLightSlice(field.vpls->vpls, field.gather.points, field.tree, transport, settings.clustering, cancel);
-  field.rays = field.gather.rays + field.clusters.evaluations;
-
-  // Which cluster a preview pass samples: by estimated contribution, with a defensive share so that
-  // clusters whose representative is hidden from the slice's centre still get sampled elsewhere in it.
-  field.clusterChoice.resize(field.clusters.slices.size());
-  for (size_t s = 0; s < field.clusters.slices.size(); ++s) {
-    const auto& clusters = field.clusters.slices[s].clusters;
-    std::vector<float> w(clusters.size());
-    double sum = 0.0;
-    for (const VplCluster& c : clusters) sum += c.estimate;
-    const float mean = clusters.empty() ? 0.0f : float(sum / double(clusters.size()));
-    for (size_t c = 0; c < clusters.size(); ++c)
-      w[c] = mean > 0.0f ? clusters[c].estimate + 0.1f * mean : clusters[c].totalPower;
-    field.clusterChoice[s] = Distribution1D(w);
-  }
-  return field;
-}
-
-namespace {
-
 // One emitter sample, unweighted: the preview has no BSDF-sampled light to combine it with.
 glm::vec3 directLight(const RenderScene& scene, const SurfaceHit& surface, const Bsdf& bsdf, const glm::vec3& wo, Rng& rng,
                       PathStats& stats) {
@@ -119,6 +87,34 @@ glm::vec3 reflectedLight(const RenderScene& scene, SurfaceHit surface, Bsdf bsdf
 }
 
 }  // namespace
+
+VplField buildVplField(const RenderScene& scene, const Camera& camera, std::shared_ptr<const VplSet> vpls,
+                       const PreviewSettings& settings, const std::atomic<bool>* cancel) {
+  VplField field;
+  field.vpls = std::move(vpls);
+  field.gather = gatherPrimaryHits(scene, camera);
+  const float diagonal = 2.0f * scene.radius();
+  field.tree = buildSliceTree(field.gather.points, settings.slices, diagonal);
+  field.minDistance = settings.clampFraction * diagonal;
+  const SliceTransport transport(scene, field);
+  field.clusters = clusterLightSlice(field.vpls->vpls, field.gather.points, field.tree, transport, settings.clustering, cancel);
+  field.rays = field.gather.rays + field.clusters.evaluations;
+
+  // Which cluster a preview pass samples: by estimated contribution, with a defensive share so that
+  // clusters whose representative is hidden from the slice's centre still get sampled elsewhere in it.
+  field.clusterChoice.resize(field.clusters.slices.size());
+  for (size_t s = 0; s < field.clusters.slices.size(); ++s) {
+    const auto& clusters = field.clusters.slices[s].clusters;
+    std::vector<float> w(clusters.size());
+    double sum = 0.0;
+    for (const VplCluster& c : clusters) sum += c.estimate;
+    const float mean = clusters.empty() ? 0.0f : float(sum / double(clusters.size()));
+    for (size_t c = 0; c < clusters.size(); ++c)
+      w[c] = mean > 0.0f ? clusters[c].estimate + 0.1f * mean : clusters[c].totalPower;
+    field.clusterChoice[s] = Distribution1D(w);
+  }
+  return field;
+}
 
 PixelShaderFactory previewShader(const RenderScene& scene, const VplField& field, const PreviewSettings& settings) {
   const int m = settings.clustersPerPass;
