@@ -7,7 +7,11 @@
 // itself, estimated with independent paths, on the same equal-area map and mixed with the BSDF as
 // `mis` is (it bounds what a better target could gain at this vertex). Usage:
 //   guide_quality SCENE [cache points=48] [directions=4096] [paths per direction=8] [width=320] [height=240]
-// Environment overrides of the defaults: GQ_VPLS (count), GQ_CONE (degrees), GQ_DEFENSIVE, GQ_CLAMP, GQ_SPREAD.
+// The oracle is learned at other directions of the same strata than those it is judged on, with its
+// own paths (a table of cells cannot know g at the test direction); it needs about 4 directions per
+// cell and well-converged g (4096 directions x 64 paths) or its own noise makes it look worse than it is.
+// Environment overrides of the defaults: GQ_VPLS (count), GQ_CONE (degrees), GQ_DEFENSIVE, GQ_CLAMP, GQ_SPREAD;
+// GQ_UNCLUSTERED=1 builds the guide from every VPL (no clustering); GQ_ORACLE_CONE (degrees) blurs the oracle.
 // GQ_DUMP=C prints cache point C and each direction's share of the guide's second moment on stderr.
 #include <algorithm>
 #include <cstdio>
@@ -30,22 +34,56 @@ struct Moments {
   double oracle = 0.0;  // an ideal tabulated guide: g itself (from independent paths) on the same map, mixed as mis
 };
 
+// The same target built from every VPL (no clustering), each with its own visibility test.
+GuideDistribution unclustered(const RenderScene& scene, const VplField& vplField, const SurfaceHit& at, float cone, float defensive) {
+  std::vector<GuideRepresentative> reps;
+  for (const Vpl& light : vplField.vpls->vpls) {
+    const glm::vec3 d = light.position - at.position;
+    const float dist2 = glm::dot(d, d);
+    if (!(dist2 > 0.0f)) continue;
+    const glm::vec3 dir = d / std::sqrt(dist2);
+    const float cosReceiver = glm::dot(dir, at.shadingNormal);
+    if (cosReceiver <= 0.0f) continue;
+    const Bsdf emitter(light.bsdf, Frame::fromNormal(light.normal));
+    const float w = luminance(emitter.eval(light.incident, -dir) * light.flux) * cosReceiver /
+                    std::max(dist2, vplField.minDistance * vplField.minDistance);
+    if (!(w > 0.0f) || scene.accel().occluded(spawnShadowRay(at, dir, std::sqrt(dist2)))) continue;
+    reps.push_back({dir, w, 0.0f});
+  }
+  return GuideDistribution(reps, cone, defensive);
+}
+
+// g(w) = f(wo, w) cos L_ind(w) by `paths` brdf paths: the light the next vertex reflects, its emission excluded.
+double indirect(const RenderScene& scene, const PathTracer& tracer, const SurfaceHit& at, const Bsdf& bsdf, const glm::vec3& wo,
+                const glm::vec3& w, int paths, Rng& rng, BsdfContinuation& continuation, PathStats& stats) {
+  const glm::vec3 f = bsdf.eval(wo, w);
+  if (isBlack(f) || glm::dot(w, at.shadingNormal) <= 0.0f) return 0.0;
+  glm::vec3 l(0.0f);
+  const Ray ray = spawnRay(at, w);
+  for (int k = 0; k < paths; ++k) l += tracer.radiance(ray, rng, continuation, stats);
+  const RayHit hit = scene.accel().intersect(ray);
+  if (hit.valid()) l -= float(paths) * scene.emitters().emitted(scene.surface(ray, hit), -w);  // next-event estimation's share
+  return std::max(0.0f, luminance(f * l)) / paths;
+}
+
 // Stratified uniform sphere directions: each carries g and all strategies' pdfs.
-Moments measure(const RenderScene& scene, const PathTracer& tracer, const GuideField& field, int c, const glm::vec3& wo,
-                int directions, int paths, uint64_t seed) {
-  const CachePoint& cp = field.point(c);
+Moments measure(const RenderScene& scene, const PathTracer& tracer, const GuideField& field, const VplField& vplField,
+                int c, const glm::vec3& wo, int directions, int paths, uint64_t seed) {
+  CachePoint cp = field.point(c);
   SurfaceHit at;
   at.position = cp.position;
   at.shadingNormal = cp.normal;
   at.geometricNormal = cp.normal;
   at.coordinateScale = scene.coordinateScale();
   const Bsdf bsdf = scene.bsdf(at);
+  if (std::getenv("GQ_UNCLUSTERED"))
+    cp.distribution = unclustered(scene, vplField, at, field.settings().coneAngle, field.settings().defensive);
   const int side = int(std::sqrt(double(directions)));
   const float pBsdf = field.settings().bsdfProbability;
   Moments m;
   const bool dump = std::getenv("GQ_DUMP") && std::atoi(std::getenv("GQ_DUMP")) == c;
   Rng rng(seed, uint64_t(c));
-  struct Sample { glm::vec3 w; double g; float gOracle; };
+  struct Sample { glm::vec3 w; double g; float gOracle; glm::vec3 wTest; };
   std::vector<Sample> samples;
   BsdfContinuation continuation;
   PathStats stats;
@@ -54,18 +92,12 @@ Moments measure(const RenderScene& scene, const PathTracer& tracer, const GuideF
     const glm::vec3 w = sampleUniformSphere(u);
     const glm::vec3 f = bsdf.eval(wo, w);
     if (isBlack(f) || glm::dot(w, cp.normal) <= 0.0f) continue;
-    glm::vec3 l(0.0f), lOracle(0.0f);
-    const Ray ray = spawnRay(at, w);
-    for (int k = 0; k < paths; ++k) l += tracer.radiance(ray, rng, continuation, stats);
-    for (int k = 0; k < paths; ++k) lOracle += tracer.radiance(ray, rng, continuation, stats);
-    const RayHit hit = scene.accel().intersect(ray);
-    if (hit.valid()) {
-      const SurfaceHit s = scene.surface(ray, hit);
-      l -= float(paths) * scene.emitters().emitted(s, -w);  // next-event estimation's share
-      lOracle -= float(paths) * scene.emitters().emitted(s, -w);
-    }
-    const double g = std::max(0.0f, luminance(f * l)) / paths;
-    samples.push_back({w, g, std::max(0.0f, luminance(f * lOracle)) / float(paths)});
+    // The oracle learns g at another direction of the same stratum, with its own paths: it must not
+    // read g at the very direction it is judged on, which a table of cells could not do either.
+    const glm::vec3 wOracle =
+        sampleUniformSphere({(float(i % side) + rng.uniform()) / side, (float(i / side) + rng.uniform()) / side});
+    const double g = indirect(scene, tracer, at, bsdf, wo, w, paths, rng, continuation, stats);
+    samples.push_back({wOracle, g, float(indirect(scene, tracer, at, bsdf, wo, wOracle, paths, rng, continuation, stats)), w});
     const double pu = uniformSpherePdf(), pb = bsdf.pdf(wo, w), pg = cp.distribution.pdf(w);
     const double pm = pBsdf * pb + (1.0 - pBsdf) * pg;
     const double n = double(side) * side;
@@ -80,9 +112,10 @@ Moments measure(const RenderScene& scene, const PathTracer& tracer, const GuideF
   // The oracle is built from the second, independent estimate so that it cannot fit the first one's noise.
   std::vector<GuideRepresentative> truth;
   for (const Sample& x : samples) truth.push_back({x.w, x.gOracle, 0.0f});
-  const GuideDistribution oracle(truth, 0.0f, cp.distribution.defensive());
+  const float oracleCone = std::getenv("GQ_ORACLE_CONE") ? float(std::atof(std::getenv("GQ_ORACLE_CONE")) * kPi / 180.0) : 0.0f;
+  const GuideDistribution oracle(truth, oracleCone, cp.distribution.defensive());
   for (const Sample& x : samples) {
-    const double pm = pBsdf * bsdf.pdf(wo, x.w) + (1.0 - pBsdf) * oracle.pdf(x.w);
+    const double pm = pBsdf * bsdf.pdf(wo, x.wTest) + (1.0 - pBsdf) * oracle.pdf(x.wTest);
     m.oracle += x.g * x.g / (pm * uniformSpherePdf()) / (double(side) * side);
   }
   if (dump)
@@ -118,10 +151,10 @@ int main(int argc, char** argv) {
     tbb::parallel_for(size_t(0), results.size(), [&](size_t i) {
       const int c = int(i * field.size() / results.size());
       const uint32_t g = vplField.tree.slices[size_t(c)].representative;
-      results[i] = measure(scene, tracer, field, c, vplField.gather.wo[g], directions, paths, 7);
+      results[i] = measure(scene, tracer, field, vplField, c, vplField.gather.wo[g], directions, paths, 7);
     });
-    std::printf("%5s %10s %10s %10s %10s %6s\n", "cache", "integral", "var guide", "var mis", "var oracle", "reps");
-    std::vector<double> guideRatio, misRatio, oracleRatio;
+    std::printf("%5s %10s %10s %10s %10s %10s %6s\n", "cache", "integral", "rel bsdf", "var guide", "var mis", "var oracle", "reps");
+    std::vector<double> guideRatio, misRatio, oracleRatio, relBsdf;
     for (size_t i = 0; i < results.size(); ++i) {
       const Moments& m = results[i];
       const double vb = m.bsdf - m.mean * m.mean, vg = m.guide - m.mean * m.mean, vm = m.mis - m.mean * m.mean;
@@ -130,14 +163,16 @@ int main(int argc, char** argv) {
       misRatio.push_back(vm / vb);
       const double vo = m.oracle - m.mean * m.mean;
       oracleRatio.push_back(vo / vb);
+      relBsdf.push_back(vb / (m.mean * m.mean));
       const int c = int(i * field.size() / results.size());
-      std::printf("%5d %10.4g %10.3f %10.3f %10.3f %6zu\n", c, m.mean, vg / vb, vm / vb, vo / vb, field.point(c).distribution.size());
+      std::printf("%5d %10.4g %10.3f %10.3f %10.3f %10.3f %6zu\n", c, m.mean, vb / (m.mean * m.mean), vg / vb, vm / vb, vo / vb,
+                  field.point(c).distribution.size());
     }
     auto median = [](std::vector<double> v) { std::sort(v.begin(), v.end()); return v.empty() ? 0.0 : v[v.size() / 2]; };
     auto mean = [](const std::vector<double>& v) { double s = 0; for (double x : v) s += x; return v.empty() ? 0.0 : s / v.size(); };
     std::printf("variance relative to BSDF sampling: guide median %.3f mean %.3f, mis median %.3f mean %.3f, "
-                "oracle mis median %.3f mean %.3f\n", median(guideRatio), mean(guideRatio), median(misRatio),
-                mean(misRatio), median(oracleRatio), mean(oracleRatio));
+                "oracle mis median %.3f mean %.3f; BSDF sampling's relative variance median %.3f\n", median(guideRatio),
+                mean(guideRatio), median(misRatio), mean(misRatio), median(oracleRatio), mean(oracleRatio), median(relBsdf));
   } catch (const InputError& e) {
     std::fprintf(stderr, "guide_quality: %s\n", e.what());
     return 2;
