@@ -35,11 +35,8 @@ Bsdf::Bsdf(const BsdfParams& params, const Frame& shadingFrame) : params_(params
 
 glm::vec3 Bsdf::specularAlbedo(float mu) const {
   if (!hasSpecular()) return glm::vec3(0.0f);
-  if (mu == cachedMu_) return cachedAlbedo_;
   const AlbedoTerms e = vpl::specularAlbedo(mu, params_.alpha);
-  cachedMu_ = mu;
-  cachedAlbedo_ = glm::clamp(params_.f0 * e.a + params_.f90 * e.b, glm::vec3(0.0f), glm::vec3(1.0f));
-  return cachedAlbedo_;
+  return glm::clamp(params_.f0 * e.a + params_.f90 * e.b, glm::vec3(0.0f), glm::vec3(1.0f));
 }
 
 // Probability of sampling the specular lobe: its share of the albedo seen from wo.
@@ -57,7 +54,6 @@ glm::vec3 Bsdf::evalLocal(const glm::vec3& wo, const glm::vec3& wi) const {
   glm::vec3 f(0.0f);
   if (!isBlack(diffuseScale_)) {
     if (hasSpecular()) {
-      // E(mu_o) first, so the cache keeps it for the next call at this vertex.
       const glm::vec3 eo = specularAlbedo(wo.z);
       const AlbedoTerms ti = vpl::specularAlbedo(wi.z, params_.alpha);
       const glm::vec3 ei = glm::clamp(params_.f0 * ti.a + params_.f90 * ti.b, glm::vec3(0.0f), glm::vec3(1.0f));

@@ -48,10 +48,9 @@ class Bsdf {
   Frame frame_;
   glm::vec3 diffuseScale_{0.0f};  // diffuse / (pi (1 - E_avg)): the coupled diffuse lobe's constant
 
-  glm::vec3 specularAlbedo(float mu) const;  // E(mu) per channel; 0 without a specular lobe
-  // E(mu_o) is needed several times per vertex for the same wo: remember the last one.
-  mutable float cachedMu_ = -1.0f;
-  mutable glm::vec3 cachedAlbedo_{0.0f};
+  // E(mu) per channel; 0 without a specular lobe. Not cached: one BSDF is read by several threads at
+  // once (LightSlice's rows), and a table lookup costs less than keeping a cache coherent.
+  glm::vec3 specularAlbedo(float mu) const;
   bool hasSpecular() const { return params_.f90 > 0.0f || params_.f0.x > 0.0f || params_.f0.y > 0.0f || params_.f0.z > 0.0f; }
   float specularProbability(float cosO) const;
   glm::vec3 evalLocal(const glm::vec3& wo, const glm::vec3& wi) const;

@@ -1,5 +1,8 @@
-// The BSDF: sampling matches its pdf (chi-square), the pdf integrates to one, reciprocity, energy.
+// The BSDF: sampling matches its pdf (chi-square), the pdf integrates to one, reciprocity, energy;
+// one BSDF may be read by several threads at once (the light matrix rows of LightSlice are).
 #include <cmath>
+#include <thread>
+#include <vector>
 #include "render/core/color.h"
 #include "render/material/bsdf.h"
 #include "render/sampling/rng.h"
@@ -167,6 +170,25 @@ TEST(Bsdf, ExtremesStayFinite) {
       }
     }
   EXPECT_TRUE(makeBsdf({"mirror", glm::vec3(0.0f), glm::vec3(1.0f), 1.0f, 0.0f}).isNearSpecular());
+}
+
+// Plain std::threads, so that the ThreadSanitizer run (tests/e2e/tsan_session.sh) sees every access.
+TEST(Bsdf, OneBsdfEvaluatesTheSameFromSeveralThreadsAtOnce) {
+  const Bsdf shared = makeBsdf({"dielectric", glm::vec3(0.7f, 0.5f, 0.3f), glm::vec3(0.04f), 1.0f, 0.3f});
+  const glm::vec3 wi = shared.frame().toWorld(directionWithCos(0.6f, 1.0f));
+  constexpr int kThreads = 4, kSteps = 2000;
+  std::vector<std::vector<glm::vec3>> expected(kThreads), got(kThreads, std::vector<glm::vec3>(kSteps));
+  auto wo = [&](int t, int i) { return shared.frame().toWorld(directionWithCos(0.05f + 0.9f * float((i * 7 + t * 13) % 97) / 96.0f, 2.0f)); };
+  for (int t = 0; t < kThreads; ++t)
+    for (int i = 0; i < kSteps; ++i) expected[size_t(t)].push_back(Bsdf(shared).eval(wo(t, i), wi));
+  std::vector<std::thread> threads;
+  for (int t = 0; t < kThreads; ++t)
+    threads.emplace_back([&, t] {
+      for (int i = 0; i < kSteps; ++i) got[size_t(t)][size_t(i)] = shared.eval(wo(t, i), wi);
+    });
+  for (std::thread& th : threads) th.join();
+  for (int t = 0; t < kThreads; ++t)
+    for (int i = 0; i < kSteps; ++i) ASSERT_EQ(got[size_t(t)][size_t(i)], expected[size_t(t)][size_t(i)]) << t << " " << i;
 }
 
 TEST(Bsdf, FresnelF0FollowsGltfExtensions) {
