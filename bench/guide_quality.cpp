@@ -44,8 +44,7 @@ GuideDistribution unclustered(const RenderScene& scene, const VplField& vplField
     const glm::vec3 dir = d / std::sqrt(dist2);
     const float cosReceiver = glm::dot(dir, at.shadingNormal);
     if (cosReceiver <= 0.0f) continue;
-    const Bsdf emitter(light.bsdf, Frame::fromNormal(light.normal));
-    const float w = luminance(emitter.eval(light.incident, -dir) * light.flux) * cosReceiver /
+    const float w = luminance(light.bsdf.eval(light.incident, -dir) * light.flux) * cosReceiver /
                     std::max(dist2, vplField.minDistance * vplField.minDistance);
     if (!(w > 0.0f) || scene.accel().occluded(spawnShadowRay(at, dir, std::sqrt(dist2)))) continue;
     reps.push_back({dir, w, 0.0f});

@@ -32,8 +32,7 @@ GuideField buildGuideField(const RenderScene& scene, const VplField& field, cons
       const glm::vec3 dir = d / std::sqrt(dist2);
       const float cosReceiver = glm::dot(dir, hit.shadingNormal);
       if (cosReceiver <= 0.0f || glm::dot(dir, hit.geometricNormal) <= 0.0f) continue;
-      const Bsdf emitter(light.bsdf, Frame::fromNormal(light.normal));
-      const float leaving = luminance(emitter.eval(light.incident, -dir) * light.flux) * (c.totalPower / repPower);
+      const float leaving = luminance(light.bsdf.eval(light.incident, -dir) * light.flux) * (c.totalPower / repPower);
       const float weight = leaving * cosReceiver / std::max(dist2, field.minDistance * field.minDistance);
       if (!(weight > 0.0f) || !std::isfinite(weight)) continue;
       if (scene.accel().occluded(spawnShadowRay(hit, dir, std::sqrt(dist2)))) continue;

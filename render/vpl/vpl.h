@@ -11,7 +11,8 @@ struct Vpl {
   glm::vec3 normal{0, 0, 1};     // shading normal, facing the side the light arrived from
   glm::vec3 flux{0.0f};          // power carried by the light path to this vertex (W), before its BSDF
   glm::vec3 incident{0, 0, 1};   // unit direction back towards where the light came from (the VPL's "wi")
-  BsdfParams bsdf;               // surface response, so glossy VPLs reflect correctly
+  Bsdf bsdf;                     // surface response in the VPL's shading frame (glossy VPLs reflect correctly),
+                                 // built once: LightSlice evaluates every VPL at every slice
   uint32_t material = 0;
   uint16_t bounce = 0;           // 0: on an emitter (direct light), >= 1: indirect
 

@@ -46,7 +46,7 @@ void traceLightPath(const RenderScene& scene, const VplSettings& settings, uint6
       v.normal = surface.shadingNormal;
       v.flux = beta;
       v.incident = wo;
-      v.bsdf = bsdf.params();
+      v.bsdf = bsdf;
       v.material = surface.material;
       v.bounce = uint16_t(std::min(depth, 65535));
       out.vpls.push_back(v);
@@ -90,9 +90,8 @@ glm::vec3 vplContribution(const Vpl& light, const glm::vec3& x, const Bsdf& rece
   const float dist2 = glm::dot(d, d);
   if (!(dist2 > 0.0f)) return glm::vec3(0.0f);
   const glm::vec3 toLight = d / std::sqrt(dist2);
-  const Bsdf emitter(light.bsdf, Frame::fromNormal(light.normal));
   // eval(wo = incident, wi = towards x) carries the cosine at the VPL; the receiver's eval carries its own.
-  const glm::vec3 leaving = emitter.eval(light.incident, -toLight);
+  const glm::vec3 leaving = light.bsdf.eval(light.incident, -toLight);
   const glm::vec3 arriving = receiver.eval(wo, toLight);
   return light.flux * leaving * arriving / std::max(dist2, minDistance * minDistance);
 }

@@ -78,13 +78,11 @@ TEST(Preview, VplOnTheReceiverIsBoundedByTheClamp) {
   light.normal = glm::vec3(0, 1, 0);
   light.incident = glm::vec3(0, 1, 0);
   light.flux = glm::vec3(1.0f);
-  light.bsdf.diffuse = glm::vec3(1.0f);
-  light.bsdf.f0 = glm::vec3(0.0f);
-  light.bsdf.f90 = 0.0f;
   BsdfParams p;
   p.diffuse = glm::vec3(1.0f);
   p.f0 = glm::vec3(0.0f);
   p.f90 = 0.0f;
+  light.bsdf = Bsdf(p, Frame::fromNormal(light.normal));
   const Bsdf receiver(p, Frame::fromNormal(glm::vec3(0, 1, 0)));
   const float minDistance = 0.01f;
   // Exactly on it: nothing (no direction); ever closer: never above flux f f / minDistance^2.
