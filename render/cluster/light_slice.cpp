@@ -63,9 +63,23 @@ class Columns {
   std::vector<float> norms_, unit_;
 };
 
+// What the per-slice loops read of every VPL, packed: the Vpl records are large, and walking them
+// once per slice was memory-bound.
+struct VplFigures {
+  std::vector<glm::vec3> position, flux;
+  std::vector<float> power;
+  explicit VplFigures(std::span<const Vpl> vpls) : position(vpls.size()), flux(vpls.size()), power(vpls.size()) {
+    for (size_t j = 0; j < vpls.size(); ++j) {
+      position[j] = vpls[j].position;
+      flux[j] = vpls[j].flux;
+      power[j] = vpls[j].power();
+    }
+  }
+};
+
 // Two-way split of a cluster: pick two far-apart members in normalised column space and give every
 // member to the nearer one; members that are zero on these rows go by VPL position.
-bool splitCluster(const Columns& cols, std::span<const Vpl> vpls, std::vector<uint32_t>& members,
+bool splitCluster(const Columns& cols, std::span<const glm::vec3> position, std::vector<uint32_t>& members,
                   std::vector<uint32_t>& left, std::vector<uint32_t>& right) {
   if (members.size() < 2) return false;
   std::vector<float> norms(members.size());
@@ -109,22 +123,22 @@ bool splitCluster(const Columns& cols, std::span<const Vpl> vpls, std::vector<ui
   if (!rest.empty()) {
     glm::vec3 lo(INFINITY), hi(-INFINITY);
     for (uint32_t j : rest) {
-      lo = glm::min(lo, vpls[j].position);
-      hi = glm::max(hi, vpls[j].position);
+      lo = glm::min(lo, position[j]);
+      hi = glm::max(hi, position[j]);
     }
     const glm::vec3 ext = hi - lo;
     const int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
     const size_t mid = rest.size() / 2;
     std::nth_element(rest.begin(), rest.begin() + mid, rest.end(),
-                     [&](uint32_t a, uint32_t b2) { return vpls[a].position[axis] < vpls[b2].position[axis]; });
+                     [&](uint32_t a, uint32_t b2) { return position[a][axis] < position[b2][axis]; });
     if (left.empty() && right.empty()) {
       left.assign(rest.begin(), rest.begin() + mid);
       right.assign(rest.begin() + mid, rest.end());
     } else {
       // Zero columns join the side whose first member is nearer in space.
-      const glm::vec3 pl = vpls[left.front()].position, pr = vpls[right.front()].position;
+      const glm::vec3 pl = position[left.front()], pr = position[right.front()];
       for (uint32_t j : rest)
-        (glm::distance(vpls[j].position, pl) <= glm::distance(vpls[j].position, pr) ? left : right).push_back(j);
+        (glm::distance(position[j], pl) <= glm::distance(position[j], pr) ? left : right).push_back(j);
     }
   }
   return !left.empty() && !right.empty();
@@ -141,6 +155,7 @@ LightSliceResult clusterLightSlice(std::span<const Vpl> vpls, std::span<const Ga
   result.slices.resize(sliceCount);
   if (n == 0 || sliceCount == 0) return result;
   std::atomic<uint64_t> evaluations{0};
+  const VplFigures figures(vpls);
 
   // 1. Reduced light matrix: rows at evenly spread slices (a seeded stride through the slices).
   const uint32_t rowCount = std::min<uint32_t>(uint32_t(settings.reducedRows), sliceCount);
@@ -185,7 +200,7 @@ LightSliceResult clusterLightSlice(std::span<const Vpl> vpls, std::span<const Ga
     if (norms[j] <= 0.0f) {
       float nearest = INFINITY;
       for (uint32_t s = 0; s < seeds.size(); ++s) {
-        const float d = glm::distance(vpls[j].position, vpls[seeds[s]].position);
+        const float d = glm::distance(figures.position[j], figures.position[seeds[s]]);
         if (d < nearest) {
           nearest = d;
           globalOf[j] = s;
@@ -241,7 +256,7 @@ LightSliceResult clusterLightSlice(std::span<const Vpl> vpls, std::span<const Ga
       const Entry top = queue.top();
       queue.pop();
       if (top.cost <= 0.0 && clusters[top.index].size() < 2) continue;
-      if (!splitCluster(local, vpls, clusters[top.index], left, right)) continue;
+      if (!splitCluster(local, figures.position, clusters[top.index], left, right)) continue;
       clusters[top.index] = left;
       clusters.push_back(right);
       queue.push({local.cost(clusters[top.index]), top.index});
@@ -257,23 +272,23 @@ LightSliceResult clusterLightSlice(std::span<const Vpl> vpls, std::span<const Ga
       VplCluster& cl = out.clusters[c];
       std::vector<float> power(clusters[c].size());
       for (size_t i = 0; i < clusters[c].size(); ++i) {
-        const Vpl& v = vpls[clusters[c][i]];
-        cl.totalFlux += v.flux;
-        power[i] = v.power();
+        const uint32_t j = clusters[c][i];
+        cl.totalFlux += figures.flux[j];
+        power[i] = figures.power[j];
         cl.totalPower += power[i];
       }
       const Distribution1D pick(power);
       cl.representative = pick.empty() ? clusters[c][0] : clusters[c][pick.sample(rng.uniform())];
       if (cl.totalPower > 0.0f) {
         double spread2 = 0.0;
-        const glm::vec3 centre = vpls[cl.representative].position;
+        const glm::vec3 centre = figures.position[cl.representative];
         for (size_t i = 0; i < clusters[c].size(); ++i) {
-          const glm::vec3 d = vpls[clusters[c][i]].position - centre;
+          const glm::vec3 d = figures.position[clusters[c][i]] - centre;
           spread2 += double(power[i]) * glm::dot(d, d);
         }
         cl.spread = float(std::sqrt(spread2 / cl.totalPower));
       }
-      const float repPower = vpls[cl.representative].power();
+      const float repPower = figures.power[cl.representative];
       cl.estimate = repPower > 0.0f ? transport.contribution(s, cl.representative, true) * (cl.totalPower / repPower) : 0.0f;
       ++evals;
       if (settings.keepMembers) {
