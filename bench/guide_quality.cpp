@@ -38,16 +38,9 @@ struct Moments {
 GuideDistribution unclustered(const RenderScene& scene, const VplField& vplField, const SurfaceHit& at, float cone, float defensive) {
   std::vector<GuideRepresentative> reps;
   for (const Vpl& light : vplField.vpls->vpls) {
-    const glm::vec3 d = light.position - at.position;
-    const float dist2 = glm::dot(d, d);
-    if (!(dist2 > 0.0f)) continue;
-    const glm::vec3 dir = d / std::sqrt(dist2);
-    const float cosReceiver = glm::dot(dir, at.shadingNormal);
-    if (cosReceiver <= 0.0f) continue;
-    const float w = luminance(light.bsdf.eval(light.incident, -dir) * light.flux) * cosReceiver /
-                    std::max(dist2, vplField.minDistance * vplField.minDistance);
-    if (!(w > 0.0f) || scene.accel().occluded(spawnShadowRay(at, dir, std::sqrt(dist2)))) continue;
-    reps.push_back({dir, w, 0.0f});
+    const auto arrival = vplArrival(light, at, vplField.minDistance);
+    if (arrival && !scene.accel().occluded(spawnShadowRay(at, arrival->direction, arrival->distance)))
+      reps.push_back({arrival->direction, arrival->weight, 0.0f});
   }
   return GuideDistribution(reps, cone, defensive);
 }
@@ -82,7 +75,7 @@ Moments measure(const RenderScene& scene, const PathTracer& tracer, const GuideF
   Moments m;
   const bool dump = std::getenv("GQ_DUMP") && std::atoi(std::getenv("GQ_DUMP")) == c;
   Rng rng(seed, uint64_t(c));
-  struct Sample { glm::vec3 w; double g; float gOracle; glm::vec3 wTest; };
+  struct Sample { glm::vec3 wTest; double g; glm::vec3 wTrain; float gTrain; };  // judged at wTest, the oracle learns at wTrain
   std::vector<Sample> samples;
   BsdfContinuation continuation;
   PathStats stats;
@@ -93,10 +86,10 @@ Moments measure(const RenderScene& scene, const PathTracer& tracer, const GuideF
     if (isBlack(f) || glm::dot(w, cp.normal) <= 0.0f) continue;
     // The oracle learns g at another direction of the same stratum, with its own paths: it must not
     // read g at the very direction it is judged on, which a table of cells could not do either.
-    const glm::vec3 wOracle =
+    const glm::vec3 wTrain =
         sampleUniformSphere({(float(i % side) + rng.uniform()) / side, (float(i / side) + rng.uniform()) / side});
     const double g = indirect(scene, tracer, at, bsdf, wo, w, paths, rng, continuation, stats);
-    samples.push_back({wOracle, g, float(indirect(scene, tracer, at, bsdf, wo, wOracle, paths, rng, continuation, stats)), w});
+    samples.push_back({w, g, wTrain, float(indirect(scene, tracer, at, bsdf, wo, wTrain, paths, rng, continuation, stats))});
     const double pu = uniformSpherePdf(), pb = bsdf.pdf(wo, w), pg = cp.distribution.pdf(w);
     const double pm = pBsdf * pb + (1.0 - pBsdf) * pg;
     const double n = double(side) * side;
@@ -108,9 +101,8 @@ Moments measure(const RenderScene& scene, const PathTracer& tracer, const GuideF
       std::fprintf(stderr, "w %6.3f %6.3f %6.3f cos %.3f g %.4g pg %.4g pb %.4g g2/pg %.4g\n", w.x, w.y, w.z,
                    glm::dot(w, cp.normal), g, pg, pb, g * g / (pg * pu) / n);
   }
-  // The oracle is built from the second, independent estimate so that it cannot fit the first one's noise.
   std::vector<GuideRepresentative> truth;
-  for (const Sample& x : samples) truth.push_back({x.w, x.gOracle, 0.0f});
+  for (const Sample& x : samples) truth.push_back({x.wTrain, x.gTrain, 0.0f});
   const float oracleCone = std::getenv("GQ_ORACLE_CONE") ? float(std::atof(std::getenv("GQ_ORACLE_CONE")) * kPi / 180.0) : 0.0f;
   const GuideDistribution oracle(truth, oracleCone, cp.distribution.defensive());
   for (const Sample& x : samples) {

@@ -5,6 +5,21 @@
 
 namespace vpl {
 
+std::optional<VplArrival> vplArrival(const Vpl& light, const SurfaceHit& at, float minDistance) {
+  const glm::vec3 d = light.position - at.position;
+  const float dist2 = glm::dot(d, d);
+  if (!(dist2 > 0.0f)) return std::nullopt;
+  VplArrival a;
+  a.distance = std::sqrt(dist2);
+  a.direction = d / a.distance;
+  const float cosReceiver = glm::dot(a.direction, at.shadingNormal);
+  if (cosReceiver <= 0.0f || glm::dot(a.direction, at.geometricNormal) <= 0.0f) return std::nullopt;
+  a.weight = luminance(light.bsdf.eval(light.incident, -a.direction) * light.flux) * cosReceiver /
+             std::max(dist2, minDistance * minDistance);
+  if (!(a.weight > 0.0f) || !std::isfinite(a.weight)) return std::nullopt;
+  return a;
+}
+
 GuideField buildGuideField(const RenderScene& scene, const VplField& field, const GuideSettings& settings) {
   const size_t sliceCount = field.tree.slices.size();
   std::vector<CachePoint> points(sliceCount);
@@ -26,19 +41,14 @@ GuideField buildGuideField(const RenderScene& scene, const VplField& field, cons
     for (const VplCluster& c : clusters) {
       const Vpl& light = field.vpls->vpls[c.representative];
       const float repPower = light.power();
-      const glm::vec3 d = light.position - hit.position;
-      const float dist2 = glm::dot(d, d);
-      if (!(repPower > 0.0f) || !(dist2 > 0.0f)) continue;
-      const glm::vec3 dir = d / std::sqrt(dist2);
-      const float cosReceiver = glm::dot(dir, hit.shadingNormal);
-      if (cosReceiver <= 0.0f || glm::dot(dir, hit.geometricNormal) <= 0.0f) continue;
-      const float leaving = luminance(light.bsdf.eval(light.incident, -dir) * light.flux) * (c.totalPower / repPower);
-      const float weight = leaving * cosReceiver / std::max(dist2, field.minDistance * field.minDistance);
+      if (!(repPower > 0.0f)) continue;
+      const auto arrival = vplArrival(light, hit, field.minDistance);
+      if (!arrival) continue;
+      const float weight = arrival->weight * (c.totalPower / repPower);  // the whole cluster's
       if (!(weight > 0.0f) || !std::isfinite(weight)) continue;
-      if (scene.accel().occluded(spawnShadowRay(hit, dir, std::sqrt(dist2)))) continue;
+      if (scene.accel().occluded(spawnShadowRay(hit, arrival->direction, arrival->distance))) continue;
       // A cluster seen under a wide angle (near, or large) spreads over the angle it subtends.
-      const float dist = std::sqrt(dist2);
-      reps.push_back({dir, weight, std::atan2(settings.spreadScale * c.spread, dist)});
+      reps.push_back({arrival->direction, weight, std::atan2(settings.spreadScale * c.spread, arrival->distance)});
     }
     cp.distribution = GuideDistribution(std::move(reps), settings.coneAngle, settings.defensive);
   });

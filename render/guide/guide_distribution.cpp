@@ -59,6 +59,7 @@ class CellCentres {
 
 // A cone around a unit vector is a ball of this squared chord: |w - d|^2 = 2 (1 - cos theta). From
 // the angle, 4 sin^2(theta/2) keeps its precision for narrow cones, where 1 - cos cancels.
+float chord2FromCos(float cosCone) { return 2.0f * (1.0f - cosCone); }
 float chord2FromAngle(float angle) {
   const float s = std::sin(0.5f * std::min(angle, 3.14159265f));
   return 4.0f * s * s;
@@ -70,11 +71,11 @@ int GuideDistribution::cellOf(const glm::vec3& w) { return equalAreaCell(w, kRes
 glm::vec3 GuideDistribution::cellCentre(int cell) { return CellCentres::get().centre(cell); }
 
 void GuideDistribution::coneCells(const glm::vec3& d, float cosCone, std::vector<uint32_t>& cells) {
-  CellCentres::get().within(d, 2.0f * (1.0f - cosCone), cells);
+  CellCentres::get().within(d, chord2FromCos(cosCone), cells);
 }
 
 void GuideDistribution::coneCellsLinear(const glm::vec3& d, float cosCone, std::vector<uint32_t>& cells) {
-  const float chord2 = 2.0f * (1.0f - cosCone);
+  const float chord2 = chord2FromCos(cosCone);
   for (int c = 0; c < kCells; ++c) {
     const glm::vec3 e = cellCentre(c) - d;
     if (glm::dot(e, e) <= chord2) cells.push_back(uint32_t(c));
