@@ -1,9 +1,11 @@
 // The glTF loader on real files: the public sample scenes, the built-in scenes, and broken files.
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sys/resource.h>
 #include <unistd.h>
+#include <stb_image.h>
 #include <stb_image_write.h>
 #include "render/core/error.h"
 #include "render/scene/gltf_loader.h"
@@ -76,15 +78,38 @@ TEST(GltfLoader, FirstPerspectiveCamera) {
   EXPECT_LT(scene.camera->target.z, scene.camera->eye.z);  // looks down -Z
 }
 
+// The sRGB electro-optical transfer function (IEC 61966-2-1), in double: the reference the
+// loader's 8-bit table must match.
+double srgbByteToLinear(int byte) {
+  const double c = byte / 255.0;
+  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+}
+
 TEST(GltfLoader, SrgbBaseColorTextureIsDecodedToLinear) {
   VPL_REQUIRE_SHARED_SCENE(path, "BoxTextured/glTF/BoxTextured.gltf");
   const SceneData scene = loadGltf(path);
   ASSERT_EQ(scene.textures.size(), 1u);
-  // The decoded texels are linear: a mid-grey 8-bit sRGB value 128 is 0.2158 linear.
-  bool anyMid = false;
-  for (const glm::vec4& t : scene.textures[0].texels) anyMid |= std::abs(t.x - 0.2158f) < 0.002f;
-  EXPECT_TRUE(anyMid || !scene.textures[0].texels.empty());
-  EXPECT_GE(scene.materials[scene.meshes[0].material].baseColorTexture, 0);
+  EXPECT_EQ(scene.materials[scene.meshes[0].material].baseColorTexture, 0);
+  // The file's own bytes, decoded here: every texel's colour is the sRGB decode of its byte, alpha
+  // stays linear. A loader that skipped the decode would give 0.502 for byte 128 instead of 0.216.
+  int w = 0, h = 0, comp = 0;
+  unsigned char* bytes = stbi_load((fs::path(path).parent_path() / "CesiumLogoFlat.png").c_str(), &w, &h, &comp, 4);
+  ASSERT_NE(bytes, nullptr);
+  const Texture& t = scene.textures[0];
+  ASSERT_EQ(t.width, w);
+  ASSERT_EQ(t.height, h);
+  ASSERT_EQ(t.texels.size(), size_t(w) * size_t(h));
+  size_t mid = 0;
+  for (size_t p = 0; p < t.texels.size(); ++p) {
+    const unsigned char* b = bytes + 4 * p;
+    for (int c = 0; c < 3; ++c) {
+      ASSERT_NEAR(t.texels[p][c], srgbByteToLinear(b[c]), 1e-5) << "texel " << p << " channel " << c << " byte " << int(b[c]);
+      mid += b[c] >= 32 && b[c] <= 224;
+    }
+    ASSERT_NEAR(t.texels[p].w, b[3] / 255.0, 1e-6) << "texel " << p;
+  }
+  stbi_image_free(bytes);
+  EXPECT_GT(mid, t.texels.size() / 10) << "too few mid-range bytes for the check to mean anything";
 }
 
 TEST(GltfLoader, BuiltInScenesHaveCamerasAndLights) {
@@ -177,9 +202,9 @@ TEST_F(BrokenFile, GoodTriangleLoads) {
 
 TEST_F(BrokenFile, MissingFile) { expectError(dir / "scene" / "nope.gltf", "no such file"); }
 
-TEST_F(BrokenFile, TruncatedJson) { expectError(write("t.gltf", R"({"asset":{"version":"2.0"},"buffers":[{"byteLe)"), ""); }
+TEST_F(BrokenFile, TruncatedJson) { expectError(write("t.gltf", R"({"asset":{"version":"2.0"},"buffers":[{"byteLe)"), "parse error"); }
 
-TEST_F(BrokenFile, MissingBuffer) { expectError(write("m.gltf", triangleGltf("absent.bin", 36, 3)), ""); }
+TEST_F(BrokenFile, MissingBuffer) { expectError(write("m.gltf", triangleGltf("absent.bin", 36, 3)), "absent.bin"); }
 
 TEST_F(BrokenFile, AccessorOutOfRange) {
   const std::string data = "data:application/octet-stream;base64," + base64(floats({0, 0, 0, 1, 0, 0, 0, 1, 0}));
@@ -216,7 +241,8 @@ TEST_F(BrokenFile, UnknownRequiredExtension) {
               "EXT_magic");
 }
 
-TEST_F(BrokenFile, GarbageGlb) { expectError(write("g.glb", "glTF\x02\0\0\0garbage"), ""); }
+// 15 bytes: shorter than the 20-byte GLB header and first chunk header.
+TEST_F(BrokenFile, GarbageGlb) { expectError(write("g.glb", "glTF\x02\0\0\0garbage"), "Too short"); }
 
 // Peak resident memory of this process so far, in MB.
 double peakRssMb() {
@@ -264,20 +290,43 @@ TEST_F(BrokenFile, MissingBufferIsNotFoundRatherThanRefused) {
 }
 
 TEST_F(BrokenFile, DataUriImageIsDecodedIntoATexture) {
-  const unsigned char rgba[16] = {255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 255, 255, 255, 255};
+  // One 4x2 image used twice: as the base colour (sRGB-encoded: decoded) and as metallic-roughness
+  // (data: taken as is). Mid-range bytes, where decoding matters: 128 -> 0.2159, 188 -> 0.5029.
+  // Alpha is linear in both.
+  const unsigned char rgba[32] = {128, 188, 64, 128,  10, 1, 0, 255,   200, 100, 50, 25,  255, 230, 20, 0,
+                                  0, 32, 96, 160,    160, 96, 32, 64,  3, 11, 40, 200,    250, 150, 75, 5};
   std::string png;
   stbi_write_png_to_func([](void* out, void* bytes, int n) { static_cast<std::string*>(out)->append(static_cast<char*>(bytes), size_t(n)); },
-                         &png, 2, 2, 4, rgba, 8);
+                         &png, 4, 2, 4, rgba, 16);
   const std::string data = "data:application/octet-stream;base64," + base64(floats({0, 0, 0, 1, 0, 0, 0, 1, 0}));
-  std::string gltf = triangleGltf(data, 36, 3, R"(,"materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0}}}],)"
+  std::string gltf = triangleGltf(data, 36, 3, R"(,"materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0},)"
+                                               R"("metallicRoughnessTexture":{"index":0}}}],)"
                                                R"("textures":[{"source":0}],"images":[{"uri":"data:image/png;base64,)" + base64(png) + R"("}])");
   gltf.replace(gltf.find(R"({"POSITION":0})"), 14, R"({"POSITION":0},"material":0)");
   const SceneData s = loadGltf(write("d.gltf", gltf));
-  ASSERT_EQ(s.textures.size(), 1u);
-  ASSERT_EQ(s.textures[0].texels.size(), 4u);
-  const glm::vec4 red = s.textures[0].texels[0], white = s.textures[0].texels[3];  // sRGB 255, 0: linear 1, 0
-  EXPECT_LT(glm::length(red - glm::vec4(1, 0, 0, 1)) + glm::length(white - glm::vec4(1)), 1e-5f);
-  EXPECT_EQ(s.materials[s.meshes[0].material].baseColorTexture, 0);
+  ASSERT_EQ(s.textures.size(), 2u);
+  const Material& m = s.materials[s.meshes[0].material];
+  ASSERT_GE(m.baseColorTexture, 0);
+  ASSERT_GE(m.metallicRoughnessTexture, 0);
+  ASSERT_NE(m.baseColorTexture, m.metallicRoughnessTexture);
+  const Texture& colour = s.textures[size_t(m.baseColorTexture)];
+  const Texture& linear = s.textures[size_t(m.metallicRoughnessTexture)];
+  ASSERT_EQ(colour.width, 4);
+  ASSERT_EQ(colour.height, 2);
+  ASSERT_EQ(colour.texels.size(), 8u);
+  ASSERT_EQ(linear.texels.size(), 8u);
+  for (size_t p = 0; p < 8; ++p) {
+    for (int c = 0; c < 3; ++c) {
+      const int byte = rgba[4 * p + size_t(c)];
+      EXPECT_NEAR(colour.texels[p][c], srgbByteToLinear(byte), 1e-5) << "base colour texel " << p << " channel " << c << " byte " << byte;
+      EXPECT_NEAR(linear.texels[p][c], byte / 255.0, 1e-6) << "metallic-roughness texel " << p << " channel " << c << " byte " << byte;
+    }
+    EXPECT_NEAR(colour.texels[p].w, rgba[4 * p + 3] / 255.0, 1e-6) << "texel " << p;
+    EXPECT_NEAR(linear.texels[p].w, rgba[4 * p + 3] / 255.0, 1e-6) << "texel " << p;
+  }
+  // The anchors the issue names, against published values of the sRGB curve.
+  EXPECT_NEAR(colour.texels[0].x, 0.21586, 2e-5);  // byte 128
+  EXPECT_NEAR(colour.texels[0].y, 0.50289, 2e-5);  // byte 188
 }
 
 }  // namespace
