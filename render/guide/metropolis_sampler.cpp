@@ -11,14 +11,14 @@ MetropolisChain::MetropolisChain(const GuideDistribution& distribution, Rng& rng
 
 glm::vec3 MetropolisChain::next(const GuideDistribution& distribution, const GuideSettings& settings, Rng& rng,
                                 ChainStats& stats) {
-  const float cosPerturb = std::cos(settings.perturbationAngle);
+  const Cone perturb = Cone::fromAngle(settings.perturbationAngle);
   for (int m = 0; m < settings.mutations; ++m) {
     const float uKind = rng.uniform();
     const glm::vec2 u = rng.uniform2();
     // Both proposals are symmetric (q(x -> y) = q(y -> x)), so the acceptance is the pdf ratio.
     const glm::vec3 proposal = uKind < settings.uniformMutation
                                    ? sampleUniformSphere(u)
-                                   : glm::normalize(Frame::fromNormal(state_).toWorld(sampleUniformCone(u, cosPerturb)));
+                                   : glm::normalize(Frame::fromNormal(state_).toWorld(sampleUniformCone(u, perturb)));
     const float proposalPdf = distribution.pdf(proposal);
     ++stats.proposals;
     // The defensive term keeps both pdfs positive, so the ratio is always defined.

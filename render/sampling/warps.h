@@ -51,18 +51,32 @@ inline glm::vec3 sampleCosineHemisphere(glm::vec2 u) {
 }
 inline float cosineHemispherePdf(float cosTheta) { return cosTheta > 0.0f ? cosTheta * kInvPi : 0.0f; }
 
-// Uniform in the cone cos(theta) >= cosThetaMax. 1 - cos is carried explicitly so that cones down
-// to about 1e-3 degrees keep a correct pdf (1 - cosThetaMax is exact to float rounding of its input).
-inline glm::vec3 sampleUniformCone(glm::vec2 u, float cosThetaMax) {
-  const float oneMinusCosMax = 1.0f - cosThetaMax;
-  const float oneMinusCos = u.x * oneMinusCosMax;
+// A cone about +z given by 1 - cos of its half-angle, carried explicitly. Below about 0.02 degrees
+// cos(theta) rounds to 1 in float, and well above that 1 - cos(theta) from a float cosine has lost
+// digits (2 % at 0.1 degrees, 1e-4 at 1 degree); 2 sin^2(theta / 2) keeps them all. Take the cone from
+// its angle whenever the angle is known; fromCos is exact only for the cosine as given.
+struct Cone {
+  float oneMinusCos = 1.0f;  // in [0, 2]
+
+  static Cone fromAngle(float theta) {
+    const float s = std::sin(0.5f * std::clamp(theta, 0.0f, kPi));
+    return {2.0f * s * s};
+  }
+  static Cone fromCos(float cosTheta) { return {1.0f - std::clamp(cosTheta, -1.0f, 1.0f)}; }
+  float cosTheta() const { return 1.0f - oneMinusCos; }
+};
+
+// Uniform in the cone: 1 - cos(theta) is uniform in [0, cone.oneMinusCos], phi in [0, 2 pi).
+inline glm::vec3 sampleUniformCone(glm::vec2 u, Cone cone) {
+  const float oneMinusCos = u.x * cone.oneMinusCos;
   const float cosTheta = 1.0f - oneMinusCos;
   // sin^2 = (1 - cos)(1 + cos): no cancellation for small angles.
   const float sinTheta = std::sqrt(std::max(0.0f, oneMinusCos * (2.0f - oneMinusCos)));
   const float phi = 2.0f * kPi * u.y;
   return {sinTheta * std::cos(phi), sinTheta * std::sin(phi), cosTheta};
 }
-inline float uniformConePdf(float cosThetaMax) { return 1.0f / (2.0f * kPi * std::max(1.0f - cosThetaMax, 1e-12f)); }
+// 1 / solid angle. The floor keeps a zero-size cone finite (1.6e29); no real cone reaches it.
+inline float uniformConePdf(Cone cone) { return 1.0f / (2.0f * kPi * std::max(cone.oneMinusCos, 1e-30f)); }
 
 // Uniform barycentrics (b1, b2) on a triangle; b0 = 1 - b1 - b2 (Heitz's low-distortion map, 2019).
 inline glm::vec2 sampleUniformTriangle(glm::vec2 u) {

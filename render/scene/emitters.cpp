@@ -221,9 +221,11 @@ std::optional<EmissionSample> EmitterSet::sampleEmission(float uLight, glm::vec2
   const PunctualLight& light = punctual_[index - triangles_.size()];
   e.position = light.position;
   if (light.type == LightType::Spot) {
-    const float cosMax = glm::clamp(light.cosOuter, -1.0f, 1.0f);
-    e.direction = Frame::fromNormal(glm::normalize(light.direction)).toWorld(sampleUniformCone(uDir, cosMax));
-    e.weight = light.intensity * (spotAttenuation(light, e.direction) / (uniformConePdf(cosMax) * pmf));
+    // The scene keeps the outer cone as a cosine, so this is the cone of that cosine (exact for it);
+    // a cone so narrow that its cosine is 1 has no power above and is never sampled.
+    const Cone cone = Cone::fromCos(light.cosOuter);
+    e.direction = Frame::fromNormal(glm::normalize(light.direction)).toWorld(sampleUniformCone(uDir, cone));
+    e.weight = light.intensity * (spotAttenuation(light, e.direction) / (uniformConePdf(cone) * pmf));
   } else {
     e.direction = sampleUniformSphere(uDir);
     e.weight = light.intensity * (1.0f / (uniformSpherePdf() * pmf));

@@ -37,12 +37,12 @@ TEST(Warps, CosineHemisphereMatchesPdf) {
 
 TEST(Warps, ConesMatchPdfAndIntegrateToOne) {
   for (float degrees : {60.0f, 20.0f}) {
-    const float cosMax = std::cos(degrees * kPi / 180.0f);
+    const Cone cone = Cone::fromAngle(degrees * kPi / 180.0f);
     const glm::vec3 axis = glm::normalize(glm::vec3(0.3f, -0.5f, 0.8f));
     const Frame frame = Frame::fromNormal(axis);
     Rng rng(4);
-    auto pdf = [&](const glm::vec3& w) { return glm::dot(w, axis) >= cosMax ? double(uniformConePdf(cosMax)) : 0.0; };
-    const auto r = test::chiSquareSphere([&] { return frame.toWorld(sampleUniformCone(rng.uniform2(), cosMax)); }, pdf,
+    auto pdf = [&](const glm::vec3& w) { return glm::dot(w, axis) >= cone.cosTheta() ? double(uniformConePdf(cone)) : 0.0; };
+    const auto r = test::chiSquareSphere([&] { return frame.toWorld(sampleUniformCone(rng.uniform2(), cone)); }, pdf,
                                          200000, 64, 128, 48);
     EXPECT_GT(r.pValue, kSignificance) << degrees << " deg: " << r.report;
     EXPECT_NEAR(test::integrateSphere(pdf, 1024, 2048), 1.0, 0.02) << degrees;
@@ -53,18 +53,18 @@ TEST(Warps, NarrowConeInvertsToUniformSquare) {
   // Narrow cones are too small for sphere bins: map the samples back to the unit square instead,
   // where a uniform cone is a uniform square (1 - cos theta linear in u.x, phi linear in u.y).
   for (float degrees : {9.0f, 1.0f}) {
-    const float cosMax = std::cos(degrees * kPi / 180.0f);
+    const Cone cone = Cone::fromAngle(degrees * kPi / 180.0f);
     const int bins = 16, n = 100000;
     std::vector<double> counts(size_t(bins * bins), 0.0);
     Rng rng(10);
     for (int i = 0; i < n; ++i) {
-      const glm::vec3 w = sampleUniformCone(rng.uniform2(), cosMax);
-      ASSERT_GE(w.z, cosMax - 1e-6f);
+      const glm::vec3 w = sampleUniformCone(rng.uniform2(), cone);
+      ASSERT_GE(w.z, cone.cosTheta() - 1e-6f);
       const double sin2 = double(w.x) * w.x + double(w.y) * w.y;
       const double oneMinusCos = sin2 / (1.0 + double(w.z));  // 1 - cos without cancellation
       double phi = std::atan2(double(w.y), double(w.x));
       if (phi < 0) phi += 2.0 * std::numbers::pi;
-      const int a = std::clamp(int(oneMinusCos / (1.0 - double(cosMax)) * bins), 0, bins - 1);
+      const int a = std::clamp(int(oneMinusCos / double(cone.oneMinusCos) * bins), 0, bins - 1);
       const int b = std::clamp(int(phi / (2.0 * std::numbers::pi) * bins), 0, bins - 1);
       counts[size_t(a * bins + b)] += 1;
     }
@@ -75,12 +75,52 @@ TEST(Warps, NarrowConeInvertsToUniformSquare) {
   }
 }
 
-TEST(Warps, TinyConePdfStaysFiniteAndSamplesStayInside) {
-  const float cosMax = std::cos(1e-3f * kPi / 180.0f);
-  EXPECT_TRUE(std::isfinite(uniformConePdf(cosMax)));
-  EXPECT_TRUE(std::isfinite(uniformConePdf(1.0f)));
-  Rng rng(5);
-  for (int i = 0; i < 1000; ++i) EXPECT_GE(sampleUniformCone(rng.uniform2(), cosMax).z, cosMax - 1e-6f);
+// 1 - cos theta of a unit direction about +z, in double and without cancellation at either pole.
+double oneMinusCosOf(const glm::vec3& w) {
+  const double z = w.z, sin2 = double(w.x) * w.x + double(w.y) * w.y;
+  return z > 0.0 ? sin2 / (1.0 + z) : 1.0 - z;
+}
+
+TEST(Warps, ConePdfIsOneOverItsSolidAngleDownToTinyCones) {
+  // pdf = 1 / (2 pi (1 - cos theta)), with 1 - cos theta in double, to 1e-5 (float rounding is about
+  // 3e-7). Taken from cos theta in float, the pdf was 150x too large at 1e-3 degrees (the cosine
+  // rounds to 1), 2 % off at 0.1 degrees and 1e-4 at 1 degree.
+  for (double degrees : {1e-3, 3e-3, 0.01, 0.1, 1.0, 9.0, 30.0, 90.0, 150.0, 180.0}) {
+    const float theta = float(degrees * std::numbers::pi / 180.0);
+    const double expected = 1.0 / (2.0 * std::numbers::pi * (1.0 - std::cos(double(theta))));
+    const double pdf = uniformConePdf(Cone::fromAngle(theta));
+    EXPECT_NEAR(pdf / expected, 1.0, 1e-5) << degrees << " deg: pdf " << pdf << ", expected " << expected;
+  }
+  EXPECT_TRUE(std::isfinite(uniformConePdf(Cone::fromAngle(0.0f))));
+}
+
+TEST(Warps, TinySmallAndLargeConesSampleUniformlyInside) {
+  // Inverted to the unit square (1 - cos theta over the cone's, phi over 2 pi) the samples of a
+  // uniform cone are uniform: 8x8 bins, chi-square; and none lies outside the cone.
+  for (double degrees : {1e-3, 0.1, 60.0, 150.0}) {
+    const Cone cone = Cone::fromAngle(float(degrees * std::numbers::pi / 180.0));
+    const double oneMinusCosMax = 1.0 - std::cos(degrees * std::numbers::pi / 180.0);
+    const int bins = 8, n = 32000;
+    std::vector<double> counts(size_t(bins * bins), 0.0);
+    Rng rng(5);
+    double outside = 0.0;
+    for (int i = 0; i < n; ++i) {
+      const glm::vec3 w = sampleUniformCone(rng.uniform2(), cone);
+      ASSERT_NEAR(glm::length(w), 1.0f, 1e-5f);
+      const double a = oneMinusCosOf(w) / oneMinusCosMax;
+      outside = std::max(outside, a - 1.0);
+      double phi = std::atan2(double(w.y), double(w.x));
+      if (phi < 0) phi += 2.0 * std::numbers::pi;
+      const int ia = std::clamp(int(a * bins), 0, bins - 1);
+      const int ib = std::clamp(int(phi / (2.0 * std::numbers::pi) * bins), 0, bins - 1);
+      counts[size_t(ia * bins + ib)] += 1;
+    }
+    EXPECT_LE(outside, 1e-5) << degrees << " deg: a sample lies outside the cone";
+    double chi2 = 0;
+    const double expected = double(n) / (bins * bins);
+    for (double c : counts) chi2 += (c - expected) * (c - expected) / expected;
+    EXPECT_GT(test::chiSquareTail(chi2, bins * bins - 1), kSignificance) << degrees << " deg, chi2 " << chi2;
+  }
 }
 
 // 2D binning on the unit square for warps to the disk and the triangle.
