@@ -5,6 +5,7 @@
 #include "render/film/image_metrics.h"
 #include "render/scene/gltf_loader.h"
 #include "render/session/render_job.h"
+#include "tests/unit/pixel_agreement.h"
 #include "tests/unit/support.h"
 
 namespace vpl {
@@ -49,23 +50,43 @@ TEST(Extremes, ScalingTheSceneLeavesTheImageUnchanged) {
   // Radiance does not depend on the scene's unit; ray offsets, VPL clamps and cache-point radii must
   // scale with it (the unscaled ray offsets of an earlier version lost 16 % of the light at 1e-4).
   // The same seed draws the same numbers, so the path-traced images differ only where rounding sends
-  // a path elsewhere. The preview hangs on its one VPL set, which rounding changes as a whole: it must
-  // agree within the spread between two seeds of the unscaled scene.
-  for (SamplingMode mode : {SamplingMode::Brdf, SamplingMode::Mis, SamplingMode::Preview}) {
+  // a path elsewhere: 1 % in the mean and a relMSE of 0.01 (at 64 spp the seed-to-seed relMSE is
+  // about 0.05) bound what rounding may do.
+  for (SamplingMode mode : {SamplingMode::Brdf, SamplingMode::Mis}) {
     const RenderJobResult unit = runRenderJob(small(mode, 64), cornell());
-    RenderJobSettings otherSeed = small(mode, 64);
-    otherSeed.seed = 2;
-    const double seedSpread = std::abs(relativeBias(runRenderJob(otherSeed, cornell()).image, unit.image));
-    const double tolerance = mode == SamplingMode::Preview ? 3.0 * std::max(seedSpread, 0.01) : 0.01;
     for (float s : {1e-4f, 1e4f}) {
       const RenderJobResult r = runRenderJob(small(mode, 64), scaled(cornell(), s));
       expectFinite(r, modeName(mode));
       const double bias = relativeBias(r.image, unit.image);
-      std::printf("%s scaled by %g: bias %+.4f (tolerance %.4f)\n", modeName(mode), s, bias, tolerance);
-      EXPECT_LT(std::abs(bias), tolerance) << modeName(mode) << " scaled by " << s;
-      if (mode != SamplingMode::Preview) EXPECT_LT(relMse(r.image, unit.image), 0.01) << modeName(mode) << " scaled by " << s;
+      std::printf("%s scaled by %g: bias %+.4f\n", modeName(mode), s, bias);
+      EXPECT_LT(std::abs(bias), 0.01) << modeName(mode) << " scaled by " << s;
+      EXPECT_LT(relMse(r.image, unit.image), 0.01) << modeName(mode) << " scaled by " << s;
     }
   }
+}
+
+TEST(Extremes, ScalingTheSceneLeavesThePreviewsDistributionUnchanged) {
+  // The preview hangs on its one VPL set, which rounding changes as a whole, so one seed against one
+  // seed says little (two seeds of the unscaled scene differ by about 4 % in the mean). Sixteen seeds
+  // of each are compared pixel by pixel instead: the scaled scene's preview must be the same random
+  // image. Its mean is then known to about 1 %: a preview 3 % darker after scaling fails.
+  auto batches = [](const SceneData& data) {
+    std::vector<Image> images;
+    for (uint64_t seed = 1; seed <= 32; ++seed) {
+      RenderJobSettings s = small(SamplingMode::Preview, 64);
+      s.width = 20;
+      s.height = 15;
+      s.seed = seed;
+      const RenderJobResult r = runRenderJob(s, data);
+      expectFinite(r, "preview");
+      images.push_back(r.image);
+    }
+    return test::estimateFromBatches(images);
+  };
+  const test::BatchEstimate unit = batches(cornell());
+  for (float s : {1e-4f, 1e4f})
+    test::expectAgreement(test::compareEstimates(batches(scaled(cornell(), s)), unit),
+                          "preview scaled by " + std::string(s < 1.0f ? "1e-4" : "1e4"));
 }
 
 TEST(Extremes, AMillionTimesBrighterEmitterScalesTheImageLinearly) {

@@ -1,39 +1,56 @@
-// Every sampling mode converges to the same image: guided modes against BSDF sampling on the
-// Cornell box and on the indirect-dominated two-room scene (DESIGN.md §2 step 8).
+// Every guided mode converges to the image of BSDF sampling (DESIGN.md §2 step 8), pixel by pixel,
+// on every built-in scene. Each side is a set of independent batches (distinct seeds: new VPLs, new
+// guide, new chains), so the per-pixel standard errors include everything that varies with the seed.
+// `brdf` itself is anchored to Cycles (test_cycles_anchor) and to analytic cases (furnace, sky plane,
+// light types), so a bug shared with next-event estimation or roulette does not cancel here.
 #include <cmath>
+#include <filesystem>
 #include "render/film/image_metrics.h"
+#include "render/scene/gltf_loader.h"
 #include "render/session/render_job.h"
+#include "tests/unit/pixel_agreement.h"
 #include "tests/unit/support.h"
 
 namespace vpl {
 namespace {
 
-RenderJobResult render(const std::string& scene, SamplingMode mode, int spp, uint64_t seed,
-                       int guidedVertices = GuideSettings{}.guidedVertices) {
-  RenderJobSettings s;
-  s.guide.guidedVertices = guidedVertices;
-  s.scenePath = test::sourceDir() + "/scenes/" + scene;
-  s.mode = mode;
-  s.width = 32;
-  s.height = 24;
-  s.spp = spp;
-  s.seed = seed;
-  s.tracer.maxDepth = 8;
-  s.preview.vpl.count = 4096;
-  return runRenderJob(s);
+constexpr int kWidth = 16, kHeight = 12, kMaxDepth = 8;
+// Few pixels with many samples each: a per-pixel bias stands out of less noise.
+constexpr int kBatches = 16, kSpp = 256;
+
+std::string scenePath(const std::string& scene) {
+  if (scene == "interior.glb") return std::string(VPLVIEW_BINARY_DIR) + "/scenes/interior.glb";
+  return test::sourceDir() + "/scenes/" + scene;
 }
 
-// Difference of the two images' means, in units of its standard error (pixels are independent).
-double meanDifferenceInSigmas(const Image& a, const Image& b, int channel) {
-  double sum = 0.0, sum2 = 0.0;
-  const double n = double(a.pixels.size());
-  for (size_t i = 0; i < a.pixels.size(); ++i) {
-    const double d = double(a.pixels[i][channel]) - b.pixels[i][channel];
-    sum += d;
-    sum2 += d * d;
+RenderJobSettings settings(const std::string& scene, SamplingMode mode, int spp, uint64_t seed,
+                           int guidedVertices = GuideSettings{}.guidedVertices) {
+  RenderJobSettings s;
+  s.scenePath = scenePath(scene);
+  s.mode = mode;
+  s.width = kWidth;
+  s.height = kHeight;
+  s.spp = spp;
+  s.seed = seed;
+  s.tracer.maxDepth = kMaxDepth;
+  s.preview.vpl.count = 4096;
+  s.guide.guidedVertices = guidedVertices;
+  return s;
+}
+
+// `batches` renders of `spp` each, seeds firstSeed, firstSeed + 1, ...; the scene is read once.
+test::BatchEstimate renderBatches(const SceneData& data, const RenderJobSettings& base, int batches, uint64_t firstSeed,
+                                  uint64_t* guideSamples = nullptr, uint64_t* discarded = nullptr) {
+  std::vector<Image> images;
+  for (int b = 0; b < batches; ++b) {
+    RenderJobSettings s = base;
+    s.seed = firstSeed + uint64_t(b);
+    const RenderJobResult r = runRenderJob(s, data);
+    if (guideSamples) *guideSamples += r.guideSamples;
+    if (discarded) *discarded += r.discarded;
+    images.push_back(r.image);
   }
-  const double mean = sum / n, var = std::max(1e-30, sum2 / n - mean * mean);
-  return mean / std::sqrt(var / n);
+  return test::estimateFromBatches(images);
 }
 
 struct Case {
@@ -42,46 +59,91 @@ struct Case {
   int guidedVertices = GuideSettings{}.guidedVertices;  // 0: every vertex near a cache point
 };
 
-class GuidedModes : public ::testing::TestWithParam<Case> {};
-
-TEST_P(GuidedModes, AgreeWithBsdfSampling) {
-  const Case c = GetParam();
-  const RenderJobResult reference = render(c.scene, SamplingMode::Brdf, 1024, 1);
-  const RenderJobResult guided = render(c.scene, c.mode, 1024, 2, c.guidedVertices);
-  EXPECT_GT(guided.guideSamples, 0u) << "the guide was never used";
-  EXPECT_EQ(guided.discarded, 0u);
-  for (int ch = 0; ch < 3; ++ch) {
-    const double z = meanDifferenceInSigmas(guided.image, reference.image, ch);
-    EXPECT_LT(std::abs(z), 4.0) << modeName(c.mode) << " on " << c.scene << ", channel " << ch << ": " << z << " sigma";
-    std::printf("%s %s channel %d: %.2f sigma\n", c.scene, modeName(c.mode), ch, z);
-  }
-  std::printf("relative bias %.4f\n", relativeBias(guided.image, reference.image));
-  EXPECT_LT(std::abs(relativeBias(guided.image, reference.image)), 0.05);
+std::string caseName(const Case& c) {
+  std::string scene = c.scene;
+  scene = scene.substr(0, scene.find('.'));
+  return scene + "_" + modeName(c.mode) + (c.guidedVertices == 0 ? "_every_vertex" : "");
 }
 
-INSTANTIATE_TEST_SUITE_P(Scenes, GuidedModes,
-                         ::testing::Values(Case{"cornell_box.gltf", SamplingMode::Mis}, Case{"cornell_box.gltf", SamplingMode::Metropolis},
-                                           Case{"cornell_box.gltf", SamplingMode::Mixture}, Case{"two_rooms.gltf", SamplingMode::Mis},
-                                           Case{"two_rooms.gltf", SamplingMode::Metropolis}, Case{"two_rooms.gltf", SamplingMode::Mixture},
-                                           // Guiding every vertex near a cache point (--guided-vertices 0).
-                                           Case{"two_rooms.gltf", SamplingMode::Mis, 0}, Case{"cornell_box.gltf", SamplingMode::Metropolis, 0},
-                                           Case{"two_rooms.gltf", SamplingMode::Mixture, 0}),
-                         [](const auto& info) {
-                           return std::string(info.param.scene[0] == 'c' ? "Cornell" : "TwoRooms") + "_" + modeName(info.param.mode) +
-                                  (info.param.guidedVertices == 0 ? "_EveryVertex" : "");
-                         });
+class GuidedModes : public ::testing::TestWithParam<Case> {};
 
-TEST(GuidedModes, ErrorFallsAsOneOverSpp) {
-  // relMSE between two independent renders is twice the variance (against the reference-free mean):
-  // for an unbiased, consistent estimator it falls as 1/spp.
+TEST_P(GuidedModes, AgreeWithBsdfSamplingPixelByPixel) {
+  const Case c = GetParam();
+  const std::string path = scenePath(c.scene);
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " is not built (target interior_scene)";
+  const SceneData data = loadGltf(path);
+  const test::BatchEstimate reference =
+      renderBatches(data, settings(c.scene, SamplingMode::Brdf, kSpp, 0), kBatches, 1000);
+  uint64_t guideSamples = 0, discarded = 0;
+  const test::BatchEstimate guided =
+      renderBatches(data, settings(c.scene, c.mode, kSpp, 0, c.guidedVertices), kBatches, 2000, &guideSamples, &discarded);
+  EXPECT_GT(guideSamples, 0u) << "the guide was never used";
+  EXPECT_EQ(discarded, 0u);
+  // Sampling glossy lobes from the guide alone (metropolis, mixture) leaves rare, large weights: at
+  // 65536 spp one pixel of cornell_glossy still moved from 35 % below brdf to 50 % above it. Those
+  // modes get the heavy-tail bounds there.
+  const bool heavyTails = std::string(c.scene) == "cornell_glossy.gltf" && c.mode != SamplingMode::Mis;
+  test::expectAgreement(test::compareEstimates(guided, reference), caseName(c) + " against brdf",
+                        heavyTails ? test::kHeavyTailBounds : test::AgreementBounds{});
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    BuiltInScenes, GuidedModes,
+    ::testing::Values(Case{"cornell_box.gltf", SamplingMode::Mis}, Case{"cornell_box.gltf", SamplingMode::Metropolis},
+                      Case{"cornell_box.gltf", SamplingMode::Mixture}, Case{"cornell_glossy.gltf", SamplingMode::Mis},
+                      Case{"cornell_glossy.gltf", SamplingMode::Metropolis}, Case{"cornell_glossy.gltf", SamplingMode::Mixture},
+                      Case{"two_rooms.gltf", SamplingMode::Mis}, Case{"two_rooms.gltf", SamplingMode::Metropolis},
+                      Case{"two_rooms.gltf", SamplingMode::Mixture}, Case{"interior.glb", SamplingMode::Mis},
+                      Case{"interior.glb", SamplingMode::Metropolis},
+                      // Guiding every vertex near a cache point (--guided-vertices 0).
+                      Case{"two_rooms.gltf", SamplingMode::Mis, 0}, Case{"cornell_glossy.gltf", SamplingMode::Metropolis, 0},
+                      Case{"two_rooms.gltf", SamplingMode::Mixture, 0}),
+    [](const auto& info) { return caseName(info.param); });
+
+// The statistic is not blind: BSDF sampling against itself passes, and against itself 5 % brighter
+// in a tenth of the pixels, or 2 % brighter in alternate rows and 2 % darker in the others, it fails.
+TEST(PixelAgreement, SeesABiasInSomePixelsOrOneThatCancelsOut) {
+  const SceneData data = loadGltf(scenePath("cornell_box.gltf"));
+  const RenderJobSettings s = settings("cornell_box.gltf", SamplingMode::Brdf, kSpp, 0);
+  std::vector<Image> a, b;
+  for (int i = 0; i < kBatches; ++i) {
+    RenderJobSettings si = s;
+    si.seed = 3000 + uint64_t(i);
+    a.push_back(runRenderJob(si, data).image);
+    si.seed = 4000 + uint64_t(i);
+    b.push_back(runRenderJob(si, data).image);
+  }
+  const test::BatchEstimate reference = test::estimateFromBatches(b);
+  test::expectAgreement(test::compareEstimates(test::estimateFromBatches(a), reference), "brdf against brdf");
+
+  auto biased = [&](auto scaleOfPixel) {
+    std::vector<Image> images = a;
+    for (Image& image : images)
+      for (size_t i = 0; i < image.pixels.size(); ++i) image.pixels[i] *= scaleOfPixel(i);
+    return test::compareEstimates(test::estimateFromBatches(images), reference);
+  };
+  const test::Agreement tenth = biased([](size_t i) { return i % 10 == 0 ? 1.05f : 1.0f; });
+  const test::Agreement halves = biased([&](size_t i) { return (i / size_t(kWidth)) % 2 == 0 ? 1.02f : 0.98f; });
+  std::printf("5 %% in a tenth of the pixels: mean z^2 %.3f, beyond 4 sigma %.2f %%\n", tenth.meanZ2, 100 * tenth.beyond4);
+  std::printf("+-2 %% in alternate rows: image |z| %.2f, mean z^2 %.3f\n", halves.imageZ, halves.meanZ2);
+  EXPECT_TRUE(tenth.meanZ2 >= 1.6 || tenth.beyond4 >= 0.02) << "a 5 % bias in a tenth of the pixels went unseen";
+  EXPECT_GE(halves.meanZ2, 1.6) << "a bias that cancels across rows went unseen";
+  EXPECT_LT(halves.imageZ, 5.0);  // and the image mean alone would not have seen it
+}
+
+// A consistency check, not a bias check (the per-pixel tests above are): the spread between two seeds
+// falls as 1/spp. Chains shared by the pixels of a tile correlate their errors, so allow some slack
+// below the ideal ratio of 8.
+TEST(GuidedModes, SpreadBetweenSeedsFallsAsOneOverSpp) {
+  const SceneData data = loadGltf(scenePath("two_rooms.gltf"));
   for (SamplingMode mode : {SamplingMode::Mis, SamplingMode::Metropolis, SamplingMode::Mixture}) {
     auto spread = [&](int spp) {
-      return relMse(render("two_rooms.gltf", mode, spp, 11).image, render("two_rooms.gltf", mode, spp, 12).image);
+      return relMse(runRenderJob(settings("two_rooms.gltf", mode, spp, 11), data).image,
+                    runRenderJob(settings("two_rooms.gltf", mode, spp, 12), data).image);
     };
     const double e16 = spread(16), e128 = spread(128);
     std::printf("%s relMSE between seeds: 16 spp %.4g, 128 spp %.4g (ratio %.2f, ideal 8)\n", modeName(mode), e16, e128,
                 e16 / e128);
-    // Chains shared by the pixels of a tile correlate their errors, so allow some slack below 8.
     EXPECT_GT(e16 / e128, 4.0) << modeName(mode);
     EXPECT_LT(e16 / e128, 12.0) << modeName(mode);
   }
