@@ -9,6 +9,9 @@ namespace vpl {
 MetropolisChain::MetropolisChain(const GuideDistribution& distribution, Rng& rng)
     : state_(distribution.sample(rng)), statePdf_(distribution.pdf(state_)) {}
 
+MetropolisChain::MetropolisChain(const GuideDistribution& distribution, const glm::vec3& start)
+    : state_(glm::normalize(start)), statePdf_(distribution.pdf(state_)) {}
+
 glm::vec3 MetropolisChain::next(const GuideDistribution& distribution, const GuideSettings& settings, Rng& rng,
                                 ChainStats& stats) {
   const Cone perturb = Cone::fromAngle(settings.perturbationAngle);

@@ -20,6 +20,9 @@ class MetropolisChain {
   MetropolisChain() = default;
   // Starts at an exact sample of the distribution.
   MetropolisChain(const GuideDistribution& distribution, Rng& rng);
+  // Starts at a given unit direction, which is not a sample of the pdf: for tests of how the chain
+  // forgets its start.
+  MetropolisChain(const GuideDistribution& distribution, const glm::vec3& start);
 
   // Runs `settings.mutations` steps and returns the new state.
   glm::vec3 next(const GuideDistribution& distribution, const GuideSettings& settings, Rng& rng, ChainStats& stats);

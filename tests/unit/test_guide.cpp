@@ -183,6 +183,46 @@ TEST(Metropolis, LongChainVisitsBinsInProportion) {
   }
 }
 
+TEST(Metropolis, ChainsFromABadStartForgetItAndFollowThePdf) {
+  // From an exact start (the tests above) every state is already a draw of the pdf, so a chain that
+  // keeps the pdf but cannot leave where it is (say, every independent proposal rejected: the 9-degree
+  // perturbation alone) passes them. Here each chain starts where the pdf is lowest, or at the
+  // centre of the lighter of two lobes, and runs 200 steps; its last state, one per chain, is
+  // chi-square tested against the pdf. With the right rule the start is forgotten: in the slowest
+  // case, the lobes, mass moves between them at about 4 % a step (uniform proposals landing in the
+  // other lobe), so 200 steps leave e^-8 of the start.
+  GuideSettings settings;
+  const glm::vec3 axis = glm::normalize(glm::vec3(0.3f, 0.8f, 0.2f));
+  struct BadStart {
+    const char* name;
+    GuideDistribution d;
+    glm::vec3 start;
+  };
+  std::vector<BadStart> starts;
+  {
+    const GuideDistribution d(randomReps(5, 14, true), 30.0f * kDeg, 0.01f);
+    int lowest = 0;
+    for (int c = 1; c < GuideDistribution::kCells; ++c)
+      if (d.pdf(GuideDistribution::cellCentre(c)) < d.pdf(GuideDistribution::cellCentre(lowest))) lowest = c;
+    starts.push_back({"five clustered, from the lowest pdf", d, GuideDistribution::cellCentre(lowest)});
+  }
+  starts.push_back({"two lobes 1:4, from the lighter", GuideDistribution({{axis, 1.0f}, {-axis, 4.0f}}, 30.0f * kDeg, 0.01f), axis});
+  for (const BadStart& b : starts) {
+    Rng rng(15);
+    ChainStats stats;
+    auto sample = [&] {
+      MetropolisChain chain(b.d, b.start);
+      glm::vec3 w = b.start;
+      for (int k = 0; k < 200; ++k) w = chain.next(b.d, settings, rng, stats);
+      return w;
+    };
+    const auto r = test::chiSquareEqualArea(sample, [&](const glm::vec3& w) { return double(b.d.pdf(w)); }, 10000,
+                                            GuideDistribution::kResolution / 2);
+    EXPECT_GT(r.pValue, 1e-4) << b.name << ": " << r.report;
+    std::printf("%s: p-value %.3g, acceptance %.3f\n", b.name, r.pValue, double(stats.accepted) / double(stats.proposals));
+  }
+}
+
 TEST(Metropolis, SameSeedSameChain) {
   const GuideDistribution d(randomReps(50, 12), 10.0f * kDeg, 0.01f);
   GuideSettings settings;

@@ -1,8 +1,12 @@
 // The viewer's progressive session without a window: restarts discard the old view's samples,
 // modes keep their own films, every thread is joined on destruction.
 #include <chrono>
+#include <condition_variable>
+#include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <memory>
+#include <mutex>
 #include <utility>
 #include <tbb/global_control.h>
 #include <thread>
@@ -174,19 +178,70 @@ TEST(Session, RefinementComesWithItsRelativeVariance) {
   EXPECT_GT(sum, 0.0);  // 8 noisy samples per pixel
 }
 
+// Threads of this process now (Linux: one entry per thread in /proc/self/task).
+size_t threadCount() {
+  size_t n = 0;
+  for ([[maybe_unused]] const auto& entry : std::filesystem::directory_iterator("/proc/self/task")) ++n;
+  return n;
+}
+
+// Runs `body`; a watchdog thread aborts the test binary, saying what hung, if it has not returned
+// within `seconds`: a hang then fails here and now, not at CTest's timeout with no word of where.
+template <typename Body>
+double withinOrAbort(double seconds, const char* what, Body body) {
+  std::mutex m;
+  std::condition_variable cv;
+  bool done = false;
+  std::thread watchdog([&] {
+    std::unique_lock lock(m);
+    if (!cv.wait_for(lock, std::chrono::duration<double>(seconds), [&] { return done; })) {
+      std::fprintf(stderr, "%s did not return within %.0f s: aborting\n", what, seconds);
+      std::abort();
+    }
+  });
+  const auto start = std::chrono::steady_clock::now();
+  body();
+  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  {
+    std::lock_guard lock(m);
+    done = true;
+  }
+  cv.notify_all();
+  watchdog.join();
+  return elapsed;
+}
+
 TEST(Session, DestructionMidRenderJoinsEveryThread) {
   const auto scene = cornell();
+  SessionSettings s = small(SamplingMode::Mis, 1 << 16);
+  s.width = 160;
+  s.height = 120;
+  // TBB starts its workers on first use and keeps them: count the threads after one session (idle
+  // when destroyed).
+  auto idle = std::make_unique<ProgressiveSession>(scene, defaultCamera(scene->data()), small(SamplingMode::Mis, 1));
+  EXPECT_TRUE(idle->waitUntilDone(120.0));
+  double slowest = withinOrAbort(20.0, "~ProgressiveSession of an idle session", [&] { idle.reset(); });
+  const size_t before = threadCount();
   for (int i = 0; i < 5; ++i) {
-    SessionSettings s = small(SamplingMode::Mis, 1 << 16);
-    s.width = 160;
-    s.height = 120;
-    ProgressiveSession session(scene, defaultCamera(scene->data()), s);
+    auto session = std::make_unique<ProgressiveSession>(scene, defaultCamera(scene->data()), s);
     std::this_thread::sleep_for(std::chrono::milliseconds(20 * i));
-    session.setMode(SamplingMode::Metropolis);
-    session.resize(0, 0);  // a minimised window: ignored
-    session.resize(80, 60);
-  }  // ~ProgressiveSession cancels and joins; a hang here is the failure
-  SUCCEED();
+    session->setMode(SamplingMode::Metropolis);
+    session->resize(0, 0);  // a minimised window: ignored
+    session->resize(80, 60);
+    // ~ProgressiveSession cancels the pass under way and joins the controller. The bound is far
+    // above the slowest step that cannot be cancelled (a guide build: milliseconds in Release).
+    slowest = std::max(slowest, withinOrAbort(20.0, "~ProgressiveSession", [&] { session.reset(); }));
+  }
+  std::printf("slowest destruction %.1f ms\n", 1e3 * slowest);
+  // No session left a thread behind. TBB's workers may come and go, and an arena of 2 threads asks for
+  // one; a thread that has just been joined can stay listed for a moment, so look again a few times.
+  size_t after = threadCount();
+  for (int tries = 0; tries < 500 && after > before + 1; ++tries) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    after = threadCount();
+  }
+  EXPECT_LE(after, before + 1) << "threads before the sessions " << before << ", after " << after;
+  std::printf("threads before the sessions %zu, after %zu\n", before, after);
 }
 
 TEST(Session, ResizeRestartsAtTheNewSize) {
