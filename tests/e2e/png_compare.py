@@ -1,8 +1,12 @@
 #!/usr/bin/env python3
-"""Compares two 8-bit RGB PNGs by block means (pure Python: the test machines have no imaging
-modules). Usage: png_compare.py A.png B.png MAX_MEAN_DIFF MAX_BLOCK_DIFF MIN_MEAN
-Exit 0 when both images have the same size, A's mean level is at least MIN_MEAN (not black), the
-mean levels differ by at most MAX_MEAN_DIFF, and every 8x8-grid block mean by at most MAX_BLOCK_DIFF."""
+"""Compares two 8-bit sRGB PNGs by their means in linear light, whole and in an 8x8 grid of blocks
+(pure Python: the test machines have no imaging modules).
+Usage: png_compare.py A.png B.png MAX_MEAN_REL MAX_BLOCK_REL MIN_MEAN [--scale S --write OUT.png]
+Exit 0 when both images have the same size, A's mean sRGB level is at least MIN_MEAN (not black),
+the linear means differ by at most MAX_MEAN_REL of B's, and every block's linear mean by at most
+MAX_BLOCK_REL of B's (blocks darker than 1 % of B's mean are compared against 1 % of it).
+With --scale S --write OUT.png it instead writes B.png with its linear values times S (the test's
+proof that a wrongly scaled image fails)."""
 import struct, sys, zlib
 
 
@@ -41,17 +45,49 @@ def read_png(path):
     return width, height, rows
 
 
+def to_linear(level):
+    c = level / 255.0
+    return c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4
+
+
+def to_srgb_level(v):
+    v = min(max(v, 0.0), 1.0)
+    c = v * 12.92 if v <= 0.0031308 else 1.055 * v ** (1 / 2.4) - 0.055
+    return int(round(c * 255))
+
+
+LINEAR = [to_linear(level) for level in range(256)]
+
+
 def block_means(width, height, rows, grid=8):
+    """Linear-light block means (mean of the three channels), and the mean sRGB level."""
     sums = [[0.0] * grid for _ in range(grid)]
     counts = [[0] * grid for _ in range(grid)]
+    level = 0.0
     for y, line in enumerate(rows):
         by = y * grid // height
         for x in range(width):
             bx = x * grid // width
-            sums[by][bx] += (line[3 * x] + line[3 * x + 1] + line[3 * x + 2]) / 3.0
+            sums[by][bx] += (LINEAR[line[3 * x]] + LINEAR[line[3 * x + 1]] + LINEAR[line[3 * x + 2]]) / 3.0
             counts[by][bx] += 1
-    return [[sums[j][i] / max(1, counts[j][i]) for i in range(grid)] for j in range(grid)]
+            level += (line[3 * x] + line[3 * x + 1] + line[3 * x + 2]) / 3.0
+    return [[sums[j][i] / max(1, counts[j][i]) for i in range(grid)] for j in range(grid)], level / (width * height)
 
+
+def write_png(path, width, height, rows):
+    raw = b"".join(b"\x00" + bytes(line) for line in rows)
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
+    with open(path, "wb") as f:
+        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)) +
+                chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
+
+
+if "--scale" in sys.argv:
+    scale, out = float(sys.argv[sys.argv.index("--scale") + 1]), sys.argv[sys.argv.index("--write") + 1]
+    w, h, rows = read_png(sys.argv[2])
+    write_png(out, w, h, [[to_srgb_level(LINEAR[v] * scale) for v in line] for line in rows])
+    sys.exit(0)
 
 a_path, b_path = sys.argv[1], sys.argv[2]
 max_mean, max_block, min_mean = float(sys.argv[3]), float(sys.argv[4]), float(sys.argv[5])
@@ -59,11 +95,13 @@ wa, ha, ra = read_png(a_path)
 wb, hb, rb = read_png(b_path)
 if (wa, ha) != (wb, hb):
     sys.exit(f"sizes differ: {wa}x{ha} and {wb}x{hb}")
-ma, mb = block_means(wa, ha, ra), block_means(wb, hb, rb)
+(ma, level_a), (mb, _) = block_means(wa, ha, ra), block_means(wb, hb, rb)
 mean_a, mean_b = sum(map(sum, ma)) / 64, sum(map(sum, mb)) / 64
-worst = max(abs(ma[j][i] - mb[j][i]) for j in range(8) for i in range(8))
-print(f"mean level {mean_a:.1f} vs {mean_b:.1f}, worst block difference {worst:.1f}")
-if mean_a < min_mean:
-    sys.exit(f"{a_path} is black (mean level {mean_a:.1f} < {min_mean})")
-if abs(mean_a - mean_b) > max_mean or worst > max_block:
+floor = 0.01 * mean_b
+worst = max(abs(ma[j][i] - mb[j][i]) / max(mb[j][i], floor) for j in range(8) for i in range(8))
+rel = abs(mean_a - mean_b) / max(mean_b, 1e-12)
+print(f"linear mean {mean_a:.4f} vs {mean_b:.4f} ({100 * rel:.1f} % apart), worst block {100 * worst:.1f} % apart")
+if level_a < min_mean:
+    sys.exit(f"{a_path} is black (mean level {level_a:.1f} < {min_mean})")
+if rel > max_mean or worst > max_block:
     sys.exit("the images differ more than allowed")
