@@ -1,0 +1,64 @@
+#!/usr/bin/env python3
+"""The mutation check: each mutant breaks the renderer in one way a user would see; the unit suite
+must fail for every one. Usage: mutants.py list | apply NAME REPO | names.
+A mutant is (name, file, the exact text it replaces, its replacement, what it breaks)."""
+import sys
+
+MUTANTS = [
+    ("no-srgb-decode", "render/scene/gltf_materials.cpp",
+     "lut[i] = srgb ? srgbToLinear(i / 255.0f) : i / 255.0f;",
+     "lut[i] = i / 255.0f;",
+     "colour textures read as linear"),
+    ("ggx-x0.8", "render/material/bsdf.cpp",
+     "(ggx::D(h, params_.alpha) * ggx::G2(wo, wi, params_.alpha) / (4.0f * wo.z));",
+     "(0.8f * ggx::D(h, params_.alpha) * ggx::G2(wo, wi, params_.alpha) / (4.0f * wo.z));",
+     "the GGX lobe 20 % too dark"),
+    ("guide-pdf-x1.05", "render/guide/guide_distribution.cpp",
+     "return cellDensity_ * choice_.pmf(size_t(cellOf(w))) + defensive_ * uniformSpherePdf();",
+     "return 1.05f * (cellDensity_ * choice_.pmf(size_t(cellOf(w))) + defensive_ * uniformSpherePdf());",
+     "the guide's pdf 5 % too large"),
+    ("no-lambert-cosine", "render/material/bsdf.cpp",
+     "      f += diffuseScale_ * wi.z;",
+     "      f += diffuseScale_;",
+     "the Lambertian lobe without its cosine"),
+    ("no-emitter-cosine", "render/scene/emitters.cpp",
+     "s.pdf = pmf * dist2 / (std::abs(cosLight) * light.area);",
+     "s.pdf = pmf * dist2 / light.area;",
+     "area-light sampling pdf without the emitter's cosine"),
+    ("no-roulette-weight", "render/integrator/path_tracer.cpp",
+     "      beta /= survive;",
+     "",
+     "Russian roulette survivors not reweighted"),
+    ("metropolis-always-accepts", "render/guide/metropolis_sampler.cpp",
+     "if (rng.uniform() * statePdf_ < proposalPdf) {",
+     "if (true) {",
+     "every Metropolis proposal accepted"),
+    ("no-point-light-falloff", "render/scene/emitters.cpp",
+     "rangeWindow(light, s.distance) / dist2);",
+     "rangeWindow(light, s.distance));",
+     "point and spot lights without 1/r^2"),
+    ("preview-cluster-pmf-ignored", "render/vpl/vpl_preview.cpp",
+     "L += contribution / (float(m) * pmf);",
+     "L += contribution * (float(clusters.size()) / float(m));",
+     "the preview weights a sampled VPL cluster as if chosen uniformly"),
+]
+
+
+def main():
+    if sys.argv[1] == "names":
+        print(" ".join(m[0] for m in MUTANTS))
+    elif sys.argv[1] == "list":
+        for name, path, _, _, what in MUTANTS:
+            print(f"{name}\t{path}\t{what}")
+    elif sys.argv[1] == "apply":
+        name, repo = sys.argv[2], sys.argv[3]
+        (_, path, old, new, _), = [m for m in MUTANTS if m[0] == name]
+        full = f"{repo}/{path}"
+        text = open(full).read()
+        if text.count(old) != 1:
+            sys.exit(f"{name}: the text to mutate is not in {path} exactly once (the code moved: update the mutant)")
+        open(full, "w").write(text.replace(old, new))
+
+
+if __name__ == "__main__":
+    main()
