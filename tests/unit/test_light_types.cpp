@@ -288,12 +288,7 @@ TEST(LightTypes, ColouredPointLightScalesEachChannel) {
   expectPunctualImage(render(scene, view, SamplingMode::Brdf, 64, 2), e, 64, "coloured point", nullptr, kRho * colour);
 }
 
-TEST(LightTypes, SpotLightIsPointInsideInnerConeZeroOutsideOuterAndGltfCurveBetween) {
-  const View view = downView(3.0, 1.2);
-  const glm::dvec3 p(0.2, 1.5, 0.0);
-  const glm::dvec3 dir = glm::normalize(glm::dvec3(0.3, -1.0, 0.2));
-  const double intensity = 6.0, inner = 0.35, outer = 0.6;
-  SceneData scene = floorScene(view);
+PunctualLight spotLight(const glm::dvec3& p, const glm::dvec3& dir, double intensity, double inner, double outer) {
   PunctualLight light;
   light.type = LightType::Spot;
   light.position = glm::vec3(p);
@@ -301,7 +296,16 @@ TEST(LightTypes, SpotLightIsPointInsideInnerConeZeroOutsideOuterAndGltfCurveBetw
   light.intensity = glm::vec3(float(intensity));
   light.cosInner = float(std::cos(inner));
   light.cosOuter = float(std::cos(outer));
-  scene.lights.push_back(light);
+  return light;
+}
+
+TEST(LightTypes, SpotLightIsPointInsideInnerConeZeroOutsideOuterAndGltfCurveBetween) {
+  const View view = downView(3.0, 1.2);
+  const glm::dvec3 p(0.2, 1.5, 0.0);
+  const glm::dvec3 dir = glm::normalize(glm::dvec3(0.3, -1.0, 0.2));
+  const double intensity = 6.0, inner = 0.35, outer = 0.6;
+  SceneData scene = floorScene(view);
+  scene.lights.push_back(spotLight(p, dir, intensity, inner, outer));
   auto truth = [&](const glm::dvec3& x) {
     return punctual(p, intensity, x, spotAttenuation(glm::dot(dir, glm::normalize(x - p)), inner, outer));
   };
@@ -332,14 +336,7 @@ void narrowSpot(double innerDegrees, double outerDegrees, double cameraHeight, d
   const glm::dvec3 p(0.0, 1.0, 0.0), dir(0.0, -1.0, 0.0);
   const double intensity = 2.0;
   SceneData scene = floorScene(view);
-  PunctualLight light;
-  light.type = LightType::Spot;
-  light.position = glm::vec3(p);
-  light.direction = glm::vec3(dir);
-  light.intensity = glm::vec3(float(intensity));
-  light.cosInner = float(std::cos(inner));
-  light.cosOuter = float(std::cos(outer));
-  scene.lights.push_back(light);
+  scene.lights.push_back(spotLight(p, dir, intensity, inner, outer));
   const Expected e = expectedImage(view, [&](const glm::dvec3& x) {
     return punctual(p, intensity, x, spotAttenuation(glm::dot(dir, glm::normalize(x - p)), inner, outer));
   });
