@@ -27,7 +27,8 @@ for m in $mutants; do
     printf '%-28s %s\n' "$m" "(does not compile: update the mutant)"; survivors=$((survivors + 1))
   else
     failed=$(cd "$build" && ctest --parallel "$(nproc)" --timeout 600 -E '^(e2e_|cli_contract)' 2>&1 |
-             sed -n 's/^[[:space:]]*[0-9]* - \(.*\) (\(Failed\|Timeout\|Subprocess aborted\|Exception\)).*/\1/p' | tr '\n' ' ')
+             sed -n 's/^[[:space:]]*[0-9]* - \(.*\) (\(Failed\|Timeout\|Subprocess aborted\|Exception\)).*/\1/p' |
+             sed 's/  # GetParam.*//' | tr '\n' ' ')
     if [ -z "$failed" ]; then
       printf '%-28s %s\n' "$m" "SURVIVED"; survivors=$((survivors + 1))
     else
