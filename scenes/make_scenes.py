@@ -67,6 +67,23 @@ class Mesh:
                 q = q[::-1]
             self.quad(*q)
 
+    def slab(self, corner, a, b, c):
+        """A parallelepiped from corner along edges a, b, c, each face wound to face outwards."""
+        centre = add(corner, mul(add(add(a, b), c), 0.5))
+        for (o, e1, e2) in ((corner, a, b), (corner, b, c), (corner, c, a)):
+            for far in (False, True):
+                if far:
+                    third = c if e1 is a else (a if e1 is b else b)
+                    o2 = add(o, third)
+                else:
+                    o2 = o
+                q = [o2, add(o2, e1), add(add(o2, e1), e2), add(o2, e2)]
+                n = cross(e1, e2)
+                mid = add(o2, mul(add(e1, e2), 0.5))
+                if sum(n[k] * (mid[k] - centre[k]) for k in range(3)) < 0:
+                    q = q[::-1]
+                self.quad(*q)
+
     def cylinder(self, base, radius, height, segments, rings):
         """Smooth-shaded open cylinder along +Y."""
         first = len(self.positions)
@@ -258,6 +275,70 @@ def two_rooms():
     return build_gltf([floor, walls, blue, boxes, lamp], mats, ((3.7, 1.4, 1.7), (0.0, 1.0, -0.1), math.radians(60.0)))
 
 
+def door_ajar(strength=None):
+    """Light only behind a door ajar: room A (x < -T/2) holds the lamp, room B (x > T/2) the camera.
+
+    Plan (metres, +Y up; the dividing wall is T = 0.2 thick, x in [-0.1, 0.1], floor to ceiling):
+      * A floor-to-ceiling doorway, z in [-0.43, 0.43], in the dividing wall. Its door (0.04 thick)
+        hangs on the -z jamb, on room A's face of the wall, and is open 15 degrees into room A, so the
+        only way from A to B is the vertical slit between its free edge and the +z jamb corner
+        (x, z) = (-0.1, 0.43): 0.225 m at its narrowest (2.5 m tall). The door runs 5 cm past its
+        hinge line into the wall and 1 cm into floor and ceiling, and the wall's faces run 1 cm past
+        the room's, so no crack between touching surfaces leaks light.
+      * The lamp is a 0.7 x 0.6 m panel on room A's face of the dividing wall, on the hinge side
+        (z in [-1.7, -1.0]), 5 mm off the wall, emitting from its front (-X) side only. Every ray it
+        emits therefore has direction.x < 0 and stays at x < -0.105, so no straight line from the
+        lamp reaches room B (x >= 0.1): room B is lit only by light that has bounced in room A and
+        come through the slit, and the lamp itself is never seen from B (B looks at its back).
+        A render at --max-depth 1 is black; at --max-depth 2 only the pixels that see room A through
+        the slit are lit.
+      * The camera stands in room B's -z corner and looks across the doorway, through the slit, to
+        the lit far corner of room A.
+    Materials map exactly to Cycles (tools/cycles/README.md): Lambertian (metallic 0, specular 0);
+    the lamp has a black base colour.
+    """
+    lamp_strength = 1000.0 if strength is None else strength
+    mats = [material("white", (0.8, 0.8, 0.78), lambert=True), material("floor", (0.6, 0.45, 0.3), lambert=True),
+            material("terracotta", (0.7, 0.3, 0.2), lambert=True), material("blue", (0.2, 0.3, 0.7), lambert=True),
+            material("door", (0.75, 0.7, 0.6), lambert=True),
+            material("lamp", (0.0, 0.0, 0.0), emissive=(1.0, 0.9, 0.75), strength=lamp_strength, lambert=True,
+                     double_sided=False)]
+    XA, XB, D, H = -4.0, 4.5, 2.0, 2.5           # room A's far end, room B's far end, half depth, height
+    T, half_door, E = 0.2, 0.43, 0.01            # wall thickness, half the doorway, overlap of touching parts
+    angle, door_t = math.radians(15.0), 0.04
+    walls, floor, warm, blue, door, furniture, lamp = (Mesh("walls", 0), Mesh("floor", 1), Mesh("room_a_end", 2),
+                                                        Mesh("room_b_end", 3), Mesh("door", 4), Mesh("furniture", 0),
+                                                        Mesh("lamp", 5))
+    floor.quad((XA, 0, D), (XB, 0, D), (XB, 0, -D), (XA, 0, -D))
+    walls.quad((XA, H, -D), (XB, H, -D), (XB, H, D), (XA, H, D))      # ceiling
+    walls.quad((XA, 0, -D), (XB, 0, -D), (XB, H, -D), (XA, H, -D))    # side z = -D
+    walls.quad((XB, 0, D), (XA, 0, D), (XA, H, D), (XB, H, D))        # side z = +D
+    warm.quad((XA, 0, D), (XA, 0, -D), (XA, H, -D), (XA, H, D))       # room A's far end
+    blue.quad((XB, 0, -D), (XB, 0, D), (XB, H, D), (XB, H, -D))       # room B's far end
+    # The dividing wall: a solid from x = -T/2 to T/2 with the doorway cut through it (two-sided faces).
+    xa, xb, y0, y1 = -T / 2, T / 2, -E, H + E
+    for z0, z1 in ((-D - E, -half_door), (half_door, D + E)):
+        walls.quad((xa, y0, z0), (xa, y0, z1), (xa, y1, z1), (xa, y1, z0))  # room A's face, normal -X
+        walls.quad((xb, y0, z1), (xb, y0, z0), (xb, y1, z0), (xb, y1, z1))  # room B's face, normal +X
+    walls.quad((xa, y0, -half_door), (xb, y0, -half_door), (xb, y1, -half_door), (xa, y1, -half_door))  # jamb, +Z
+    walls.quad((xb, y0, half_door), (xa, y0, half_door), (xa, y1, half_door), (xb, y1, half_door))      # jamb, -Z
+    # The door: its wall-side face runs from the hinge line (on room A's face, 1 cm past the -z jamb)
+    # towards +z, turned by `angle` into room A; 5 cm of it continue into the wall behind the hinge.
+    u = (-math.sin(angle), 0.0, math.cos(angle))        # along the door, hinge to free edge
+    n = (-math.cos(angle), 0.0, -math.sin(angle))       # its thickness, into room A
+    hinge = (xa, y0, -half_door - E)
+    length = 2 * half_door + E                          # free edge: 0.225 m from the +z jamb corner
+    door.slab(add(hinge, mul(u, -0.05)), mul(u, length + 0.05), (0.0, y1 - y0, 0.0), mul(n, door_t))
+    # The lamp: on room A's face of the wall, hinge side, facing -X.
+    lx = xa - 0.005
+    lamp.quad((lx, 1.5, -1.7), (lx, 1.5, -1.0), (lx, 2.1, -1.0), (lx, 2.1, -1.7))
+    furniture.box((-3.2, 0.0, 0.6), (-2.2, 0.75, 1.5), rotate=10.0)     # room A: a table-sized block
+    furniture.box((2.4, 0.0, 1.3), (3.6, 0.9, 1.9))                     # room B: a sideboard
+    furniture.box((1.0, 0.0, -1.9), (1.8, 0.45, -0.9), rotate=15.0)     # room B: a low bench
+    return build_gltf([floor, walls, warm, blue, door, furniture, lamp], mats,
+                      ((4.0, 1.5, -1.7), (0.0, 1.0, 0.3), math.radians(60.0)))
+
+
 def interior():
     """A hall with colonnades, arches, a gallery and furniture, lit by a sun through roof openings."""
     mats = [material("stone", (0.62, 0.58, 0.52), lambert=True), material("floor", (0.55, 0.5, 0.45), roughness=0.6),
@@ -330,6 +411,7 @@ def main():
         write_gltf(out, "cornell_box", cornell(glossy=False))
         write_gltf(out, "cornell_glossy", cornell(glossy=True))
         write_gltf(out, "two_rooms", two_rooms())
+        write_gltf(out, "door_ajar", door_ajar())
     if args.interior_only or args.out:
         write_glb(os.path.join(out, "interior.glb"), interior())
 

@@ -113,7 +113,7 @@ TEST(GltfLoader, SrgbBaseColorTextureIsDecodedToLinear) {
 }
 
 TEST(GltfLoader, BuiltInScenesHaveCamerasAndLights) {
-  for (const char* name : {"cornell_box.gltf", "cornell_glossy.gltf", "two_rooms.gltf"}) {
+  for (const char* name : {"cornell_box.gltf", "cornell_glossy.gltf", "two_rooms.gltf", "door_ajar.gltf"}) {
     const SceneData scene = loadGltf(test::sourceDir() + "/scenes/" + name);
     EXPECT_TRUE(scene.camera.has_value()) << name;
     bool emissive = false;
