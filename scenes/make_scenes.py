@@ -6,7 +6,8 @@
   python3 make_scenes.py --interior-only --out DIR   # the large interior (built by CMake)
 
 Scenes: cornell_box (the viewer's default), cornell_glossy, two_rooms (light in one room, camera in
-the other), interior.glb (a sun-lit hall of more than 100K triangles, a Sponza stand-in).
+the other), door_ajar (light only behind a door open 15 degrees, camera in the other room),
+interior.glb (a sun-lit hall of more than 100K triangles, a Sponza stand-in).
 Units are metres, +Y up. Punctual intensities: candela / lux; emission: nits (emissive strength).
 """
 import argparse
@@ -290,8 +291,8 @@ def door_ajar(strength=None):
         emits therefore has direction.x < 0 and stays at x < -0.105, so no straight line from the
         lamp reaches room B (x >= 0.1): room B is lit only by light that has bounced in room A and
         come through the slit, and the lamp itself is never seen from B (B looks at its back).
-        A render at --max-depth 1 is black; at --max-depth 2 only the pixels that see room A through
-        the slit are lit.
+        A render at --max-depth 1 (direct light only) is black except where the camera sees room A
+        through the slit (checked at +12 stops); room B itself first shows light at --max-depth 2.
       * The camera stands in room B's -z corner and looks across the doorway, through the slit, to
         the lit far corner of room A.
     Materials map exactly to Cycles (tools/cycles/README.md): Lambertian (metallic 0, specular 0);
