@@ -40,7 +40,7 @@ log=$out/vs_cycles.log
 csv=$out/vs_cycles.csv
 md=$out/vs_cycles.md
 skipped=$out/vs_cycles_skipped.txt
-header="scene,budget,renderer,mode,seed,seconds,spp,samples_per_s,relmse,bias,width,height"
+header="scene,budget,renderer,mode,seed,seconds,spp,samples_per_s,relmse,bias,width,height,ref_spp"
 
 # Sizes (the issue's measurements) and reference spp per scene; other scenes: 320x240, 8192 spp.
 size_of() { case $1 in cornell_box) echo "256 256";; *) echo "320 240";; esac; }
@@ -107,14 +107,14 @@ for scene in "${scenes[@]}"; do
                               --max-bounces $bounces --threads "$THREADS" | json seconds spp)
       read -r rel bias < <("$exe" compare "$img" "$ref" | json relmse bias)
       sps=$(python3 -c "import sys; w, h, n, s = map(float, sys.argv[1:]); print(f'{w * h * n / s:.6g}')" "$W" "$H" "$spp" "$secs")
-      echo "$name,$t,cycles,path,$seed,$secs,$spp,$sps,$rel,$bias,$W,$H" | tee -a "$log" >> "$csv"
+      echo "$name,$t,cycles,path,$seed,$secs,$spp,$sps,$rel,$bias,$W,$H,$rspp" | tee -a "$log" >> "$csv"
       for mode in brdf mis; do
         img=$out/${name}_${t}s_${mode}_seed$seed.exr
         read -r vsecs vspp < <("$exe" render "$scene" --mode $mode --time "$secs" --width "$W" --height "$H" \
                                   --threads "$THREADS" --seed "$seed" --max-depth "$MAX_DEPTH" --out "$img" | json seconds spp)
         read -r rel bias < <("$exe" compare "$img" "$ref" | json relmse bias)
         sps=$(python3 -c "import sys; w, h, n, s = map(float, sys.argv[1:]); print(f'{w * h * n / s:.6g}')" "$W" "$H" "$vspp" "$vsecs")
-        echo "$name,$t,vplview,$mode,$seed,$vsecs,$vspp,$sps,$rel,$bias,$W,$H" | tee -a "$log" >> "$csv"
+        echo "$name,$t,vplview,$mode,$seed,$vsecs,$vspp,$sps,$rel,$bias,$W,$H,$rspp" | tee -a "$log" >> "$csv"
       done
     done
   done
@@ -130,7 +130,7 @@ if [ -z "${CODE:-}" ]; then
 fi
 cpu=$(grep -m1 "model name" /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')
 python3 - "$csv" "$skipped" "$THREADS" "$MAX_DEPTH" "$CODE" "$cpu" "$(nproc)" "$out" > "$md" <<'PY'
-import csv, glob, os, re, sys
+import csv, os, sys
 from statistics import mean
 path, skipped, threads, depth, commit, cpu, cores, out = sys.argv[1:]
 rows = list(csv.DictReader(open(path)))
@@ -139,9 +139,6 @@ for r in rows:
         r[k] = float(r[k])
 def group(scene, budget, renderer, mode):
     return [r for r in rows if r["scene"] == scene and r["budget"] == budget and r["renderer"] == renderer and r["mode"] == mode]
-def refspp(scene):
-    hits = [re.search(r"_(\d+)spp_", os.path.basename(p)) for p in glob.glob(os.path.join(out, f"ref_{scene}_*.exr"))]
-    return max((int(h.group(1)) for h in hits if h), default=0)
 def fmt(x):
     return f"{x:.3g}" if x < 1000 else f"{x / 1e6:.2f} M" if x >= 1e6 else f"{x:.0f}"
 order = {"cornell_box": 0, "two_rooms": 1, "door_ajar": 2}
@@ -185,7 +182,7 @@ for scene, budget in keys:
               f"{fmt(sps)} | {', '.join('%.4g' % r['relmse'] for r in g)} | {rel:.4g} | {mean(r['bias'] for r in g):+.4f} | "
               f"{ratio(sps, mean(r['samples_per_s'] for r in c))} | {ratio(rel, mean(r['relmse'] for r in c))} |")
     b = group(scene, budget, "vplview", "brdf")
-    n = refspp(scene)
+    n = int(c[0]["ref_spp"]) if c else 0
     if b and n:
         # An unbiased estimate's relMSE falls as 1/spp: the reference's own error is about brdf's times its spp / n,
         # and it adds to every row's relMSE (pulling the ratios towards 1).
