@@ -6,7 +6,7 @@
 # For every built-in scene that Cycles renders exactly (../shared/tools/cycles/README.md; the others
 # are refused by cycles-render and listed as skipped): a converged vplview reference (`vplview
 # reference`, cached in OUT_DIR under the scene's content hash, size, spp and depth), then for each
-# budget and seed, alternating: Cycles at a fixed spp chosen from a probe so that it takes about the
+# budget and seed, alternating: Cycles at a fixed spp chosen from two probes so that it takes about the
 # budget, then vplview brdf and mis with --time set to the seconds Cycles reported. Every image is
 # scored with `vplview compare IMAGE REF` (relMSE and relative bias).
 # Writes OUT_DIR/vs_cycles.csv (one row per render; rows of budgets not rerun are kept, so 10 and 60
@@ -73,10 +73,11 @@ for scene in "${scenes[@]}"; do
   if [ -n "${SCENES:-}" ] && [[ " $SCENES " != *" $name "* ]]; then continue; fi
   read -r W H < <(size_of "$name")
   bounces=$((MAX_DEPTH - 1))
-  # Probe Cycles twice at 16 spp: refused scenes exit 2 here; the faster run's seconds per spp (its
-  # fixed cost included, which makes the chosen spp err on the short side) choose the spp per budget.
+  # Probe Cycles at 16 and 64 spp: refused scenes exit 2 here; the two times give the cost per spp and
+  # the fixed cost (scene sync, kernel set-up, EXR write: about 1.7 s on the Cornell box) that choose
+  # the spp for each budget.
   probe=()
-  for n in 16 16; do
+  for n in 16 64; do
     if ! res=$("$cycles" "$scene" "$out/probe.exr" --width "$W" --height "$H" --spp $n --seed 99 \
                  --max-bounces $bounces --threads "$THREADS" 2>"$out/probe.err"); then
       why=$(tr '\n' ' ' < "$out/probe.err" | sed 's/.*NotImplementedError: //; s/ *$//' | cut -c1-200)
@@ -85,8 +86,13 @@ for scene in "${scenes[@]}"; do
     fi
     probe+=("$(json seconds <<<"$res")")
   done
-  per_spp=$(python3 -c "import sys; print(max(min(map(float, sys.argv[1:])) / 16, 1e-6))" "${probe[@]}")
-  echo "$name ${W}x$H: Cycles probes at 16 spp: ${probe[*]} s -> $per_spp s/spp" | tee -a "$log"
+  read -r per_spp fixed < <(python3 -c "
+import sys
+a, b = map(float, sys.argv[1:])
+p = (b - a) / 48
+if p <= 0.0 or a - 16 * p < 0.0: p = b / 64   # noise: no fixed part
+print(p, max(a - 16 * p, 0.0))" "${probe[@]}")
+  echo "$name ${W}x$H: Cycles probes at 16 and 64 spp: ${probe[*]} s -> $per_spp s/spp + $fixed s" | tee -a "$log"
 
   bin=${scene%.*}.bin
   hash=$(cat "$scene" $([ -f "$bin" ] && echo "$bin") | sha1sum | cut -c1-10)
@@ -100,7 +106,7 @@ for scene in "${scenes[@]}"; do
   fi
 
   for t in $budgets; do
-    cspp=$(python3 -c "import sys; t, p = map(float, sys.argv[1:]); print(max(1, round(t / p)))" "$t" "$per_spp")
+    cspp=$(python3 -c "import sys; t, f, p = map(float, sys.argv[1:]); print(max(1, round((t - f) / p)))" "$t" "$fixed" "$per_spp")
     for seed in $SEEDS; do
       img=$out/${name}_${t}s_cycles_seed$seed.exr
       read -r secs spp < <("$cycles" "$scene" "$img" --width "$W" --height "$H" --spp "$cspp" --seed "$seed" \
