@@ -94,8 +94,15 @@ Ray spawnRay(const SurfaceHit& from, const glm::vec3& wi) {
 
 Ray spawnShadowRay(const SurfaceHit& from, const glm::vec3& wi, float distance) {
   Ray r = spawnRay(from, wi);
-  // Stop just short of the light point: a relative margin keeps this scale-independent.
-  r.tMax = std::isfinite(distance) ? distance * (1.0f - 1e-4f) : INFINITY;
+  if (!std::isfinite(distance)) return r;
+  // Stop short of the light point, measured from the offset origin, by a margin that covers both a
+  // relative error of the distance and the light's own surface offset (coordinates there are of the
+  // same size as here). A margin of the distance alone let rays between close, parallel surfaces far
+  // from the origin end on the light itself.
+  const glm::vec3 target = from.position + wi * distance;
+  const float offset = glm::length(r.origin - from.position);
+  const float margin = std::max(1e-4f * distance, 2.0f * offset);
+  r.tMax = std::max(0.0f, glm::dot(target - r.origin, wi) - margin);
   return r;
 }
 

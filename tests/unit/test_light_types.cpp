@@ -390,6 +390,8 @@ TEST(LightTypes, DirectionalLightIsIlluminanceTimesCosine) {
 }
 
 // ---- Area light and sky (Monte Carlo) ------------------------------------------------------------
+void emissiveSquareOverFloor(const glm::vec3& offset);
+
 TEST(LightTypes, EmissiveSquareGivesTheRectangleFormFactor) {
   // The form factor itself, against a direct numerical integral of cos cos / (pi r^2) over the square.
   {
@@ -407,6 +409,16 @@ TEST(LightTypes, EmissiveSquareGivesTheRectangleFormFactor) {
     ASSERT_NEAR(4.0 * cornerFormFactor(1e6, 1e6, 1.0), 1.0, 1e-5);  // an infinite plane
   }
 
+  emissiveSquareOverFloor(glm::vec3(0.0f));
+}
+
+// The same scene 50 m from the origin: the shadow rays' origin offsets grow with the coordinates
+// (7.6e-4 m here), and a shadow ray that stopped short by a margin relative to the light distance
+// alone (1e-4 m) ended on the lamp itself: the floor came out black.
+TEST(LightTypes, EmissiveSquareFarFromTheOriginGivesTheSameFormFactor) { emissiveSquareOverFloor(glm::vec3(0.0f, 50.0f, 0.0f)); }
+
+// A 1 m square lamp of radiance 5 at height 1 over the floor, the whole scene moved by `offset`.
+void emissiveSquareOverFloor(const glm::vec3& offset) {
   const View view = downView(0.9, 1.6);  // below the square, so it never hides the floor
   const double a = 0.5, height = 1.0, le = 5.0;
   SceneData scene = floorScene(view);
@@ -421,6 +433,12 @@ TEST(LightTypes, EmissiveSquareGivesTheRectangleFormFactor) {
   square.material = 1;
   scene.meshes.push_back(square);
   const Expected e = expectedImage(view, [&](const glm::dvec3& x) { return le * rectangleFormFactor(x, -a, a, -a, a, height); });
+  for (MeshData& m : scene.meshes)
+    for (glm::vec3& p : m.positions) p += offset;
+  scene.camera->eye += offset;
+  scene.camera->target += offset;
+  scene.boundsMin += offset;
+  scene.boundsMax += offset;
   for (SamplingMode mode : {SamplingMode::Brdf, SamplingMode::Mis, SamplingMode::Metropolis, SamplingMode::Preview}) {
     const RenderJobResult r1 = render(scene, view, mode, 64, 11), r2 = render(scene, view, mode, 64, 12);
     expectStatisticalImage(r1, r2, e, std::string("emissive square, ") + modeName(mode), 0.02);
