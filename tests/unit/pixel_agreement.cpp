@@ -40,7 +40,7 @@ BatchEstimate estimateFromBatches(const std::vector<Image>& batches) {
 Agreement compareEstimates(const BatchEstimate& a, const BatchEstimate& b) {
   Agreement r;
   double worstZ = -1.0;
-  double sumZ2 = 0.0;
+  double sumZ = 0.0, sumZ2 = 0.0;
   int beyond4 = 0;
   for (size_t i = 0; i < a.mean.size(); ++i)
     for (int c = 0; c < 3; ++c) {
@@ -56,6 +56,7 @@ Agreement compareEstimates(const BatchEstimate& a, const BatchEstimate& b) {
         z = INFINITY;
       }
       ++r.samples;
+      if (std::isfinite(z)) sumZ += z;
       sumZ2 += std::min(z * z, 25.0);
       beyond4 += std::abs(z) > 4.0;
       if (std::abs(z) > worstZ) {
@@ -71,9 +72,12 @@ Agreement compareEstimates(const BatchEstimate& a, const BatchEstimate& b) {
     const double diff = a.imageMean[c] - b.imageMean[c];
     const double z = variance > 0.0 ? std::abs(diff) / std::sqrt(variance) : (diff == 0.0 ? 0.0 : INFINITY);
     r.imageZ = std::max(r.imageZ, z);
-    r.imageError = std::max(r.imageError, std::sqrt(variance) / std::max(std::abs(b.imageMean[c]), 1e-12));
+    const double scale = std::max(std::abs(b.imageMean[c]), 1e-12);
+    r.imageRelDiff[c] = diff / scale;
+    r.imageRelError[c] = std::sqrt(variance) / scale;
   }
   if (r.samples > 0) {
+    r.meanZ = sumZ / r.samples;
     r.meanZ2 = sumZ2 / r.samples;
     r.beyond4 = double(beyond4) / r.samples;
   }
@@ -83,6 +87,10 @@ Agreement compareEstimates(const BatchEstimate& a, const BatchEstimate& b) {
 // The bounds, for estimates of 12 or more batches each (z is then about Student t with 22 to 30
 // degrees of freedom by Welch's rule):
 // - image mean: P(|t_22| > 5) = 5e-5 per channel.
+// - mean z: counting pixels, not channels (a pixel's channels share its paths), 16 x 12 independent
+//   t variables give sd(mean z) = 0.08; 0.4 is five of those. Skewed pixels (rare bright paths:
+//   the batch variance is small exactly when the batch mean is low) pull mean z below 0: guided
+//   modes measured -0.25 to +0.09 against brdf on the built-in scenes. 32 x 24 images can use 0.25.
 // - mean of z^2 (capped at 25): its expectation is 1.07-1.10 for those t; the channels of one path
 //   and the pixels of one Metropolis chain are correlated, so its spread is measured, not assumed:
 //   over the 11 mode-scene pairs of test_guided_modes that sample glossy lobes by MIS or not at all,
@@ -90,13 +98,20 @@ Agreement compareEstimates(const BatchEstimate& a, const BatchEstimate& b) {
 //   1.6 is four of those spreads above the expectation.
 // - |z| > 4: 0.03-0.05 % of t_22..t_30 samples; 2 % leaves room for a few pixels whose batch
 //   variance came out too small.
-// At those budgets brdf against itself 5 % brighter in a tenth of the pixels reaches 1.65, and 2 %
-// brighter and darker in alternate rows (a bias the image mean cannot see) 2.16.
+// At those budgets brdf against itself 5 % brighter in a tenth of the pixels reaches 1.65, and 3 %
+// brighter and darker in alternate rows (a bias the image mean cannot see) 2.30.
 void expectAgreement(const Agreement& r, const std::string& what, const AgreementBounds& bounds) {
-  std::printf("%s: %d pixel-channels, image mean |z| %.2f (standard error %.2f %%), mean z^2 %.3f, beyond 4 sigma %.2f %%, %s\n",
-              what.c_str(), r.samples, r.imageZ, 100.0 * r.imageError, r.meanZ2, 100.0 * r.beyond4, r.worst.c_str());
+  std::printf("%s: %d pixel-channels, image mean %+.3f/%+.3f/%+.3f %% apart (standard error %.3f %%, |z| %.2f), mean z "
+              "%+.3f, mean z^2 %.3f, beyond 4 sigma %.2f %%, %s\n",
+              what.c_str(), r.samples, 100.0 * r.imageRelDiff.x, 100.0 * r.imageRelDiff.y, 100.0 * r.imageRelDiff.z,
+              100.0 * std::max({r.imageRelError.x, r.imageRelError.y, r.imageRelError.z}), r.imageZ, r.meanZ, r.meanZ2,
+              100.0 * r.beyond4, r.worst.c_str());
   EXPECT_GT(r.samples, 0) << what << ": nothing to compare";
-  EXPECT_LT(r.imageZ, bounds.imageZ) << what << ": the image means differ";
+  for (int c = 0; c < 3; ++c)
+    EXPECT_LT(std::abs(r.imageRelDiff[c]), bounds.imageZ * r.imageRelError[c] + bounds.imageFloor)
+        << what << ": the image means of channel " << c << " differ by " << 100.0 * r.imageRelDiff[c] << " % (standard error "
+        << 100.0 * r.imageRelError[c] << " %)";
+  EXPECT_LT(std::abs(r.meanZ), bounds.meanZ) << what << ": a bias of one sign over the image; " << r.worst;
   EXPECT_LT(r.meanZ2, bounds.meanZ2) << what << ": pixels differ by more than their noise; " << r.worst;
   EXPECT_LT(r.beyond4, bounds.beyond4) << what << ": too many pixels beyond 4 sigma; " << r.worst;
   EXPECT_EQ(r.exactMismatches, 0) << what << ": noise-free pixels differ; " << r.worst;

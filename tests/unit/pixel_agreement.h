@@ -24,8 +24,10 @@ BatchEstimate estimateFromBatches(const std::vector<Image>& batches);
 // where neither varies, the two must be equal (else the pixel counts as beyond every bound).
 struct Agreement {
   int samples = 0;          // pixel-channels that entered the statistics
+  double meanZ = 0.0;       // a bias of one sign over many pixels
   double imageZ = 0.0;      // the largest |z| of the image mean's channels: a bias shared by the pixels
-  double imageError = 0.0;  // the relative standard error of that difference (what imageZ can see)
+  glm::dvec3 imageRelDiff{0.0}, imageRelError{0.0};  // per channel: (a - b) / b of the image means,
+                                                     // and the standard error of that
   double meanZ2 = 0.0;      // z^2 capped at 25: ~1 (a little above: Student t) without bias; a bias
                             // of either sign in many pixels raises it, even one that cancels out
   double beyond4 = 0.0;     // fraction of |z| > 4: a bias in a few pixels
@@ -36,7 +38,10 @@ Agreement compareEstimates(const BatchEstimate& a, const BatchEstimate& b);
 
 // What two unbiased estimators stay within (the derivation and its confidence in pixel_agreement.cpp).
 struct AgreementBounds {
-  double imageZ = 5.0, meanZ2 = 1.6, beyond4 = 0.02;
+  double imageZ = 5.0, meanZ2 = 1.6, beyond4 = 0.02, meanZ = 0.4;
+  // A relative difference of the image means allowed beyond imageZ standard errors: zero between
+  // two modes of this renderer; between two renderers, the differences of their models.
+  double imageFloor = 0.0;
 };
 // For an estimator with heavy tails (guide-only sampling of glossy lobes: rare large weights), whose
 // batch variance is itself underestimated in most runs: on cornell_glossy up to 1.54 and 1.2 %.

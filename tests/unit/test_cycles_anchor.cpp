@@ -34,6 +34,7 @@
 #include "render/film/image_io.h"
 #include "render/scene/gltf_loader.h"
 #include "render/session/render_job.h"
+#include "tests/unit/pixel_agreement.h"
 #include "tests/unit/support.h"
 
 namespace vpl {
@@ -42,89 +43,6 @@ namespace {
 constexpr int kWidth = 32, kHeight = 24;
 constexpr int kMaxDepth = 8;  // = Cycles --max-bounces 7
 constexpr int kCyclesSeeds = 8;
-
-// Per pixel and channel, the mean of a set of independent images and the squared standard error of
-// that mean; the same for the image mean (from the images' own means, so exact whatever the
-// correlation between pixels, e.g. through Metropolis chains shared by a tile).
-struct Estimate {
-  int count = 0;
-  std::vector<glm::dvec3> mean, se2;
-  glm::dvec3 imageMean{0.0}, imageSe2{0.0};
-};
-
-Estimate estimate(const std::vector<Image>& images) {
-  Estimate e;
-  e.count = int(images.size());
-  const size_t n = images.front().pixels.size();
-  const double k = double(images.size());
-  e.mean.assign(n, glm::dvec3(0.0));
-  e.se2.assign(n, glm::dvec3(0.0));
-  std::vector<glm::dvec3> imageMeans;
-  for (const Image& image : images) {
-    glm::dvec3 m(0.0);
-    for (size_t i = 0; i < n; ++i) {
-      e.mean[i] += glm::dvec3(image.pixels[i]) / k;
-      m += glm::dvec3(image.pixels[i]) / double(n);
-    }
-    imageMeans.push_back(m);
-    e.imageMean += m / k;
-  }
-  for (const Image& image : images)
-    for (size_t i = 0; i < n; ++i) {
-      const glm::dvec3 d = glm::dvec3(image.pixels[i]) - e.mean[i];
-      e.se2[i] += d * d / ((k - 1.0) * k);
-    }
-  for (const glm::dvec3& m : imageMeans) e.imageSe2 += (m - e.imageMean) * (m - e.imageMean) / ((k - 1.0) * k);
-  return e;
-}
-
-struct Agreement {
-  int samples = 0;          // pixel-channels compared
-  double meanZ = 0.0;       // a bias of one sign over many pixels
-  double meanZ2 = 0.0;      // z^2 capped at 25: a bias of either sign, even one that cancels
-  double beyond4 = 0.0;     // fraction of |z| > 4: a bias in a few pixels
-  int exactMismatches = 0;  // pixel-channels with no noise on either side that still differ
-  glm::dvec3 relDiff{0.0};  // (vplview - Cycles) / Cycles of the image mean, per channel
-  glm::dvec3 relSe{0.0};    // the standard error of that, per channel
-  double imageZ = 0.0;      // the largest |relDiff / relSe| of the three channels
-  std::string worst;        // the largest |z|, for failure messages
-};
-
-Agreement compare(const Estimate& v, const Estimate& c) {
-  Agreement a;
-  double worst = -1.0;
-  for (size_t i = 0; i < v.mean.size(); ++i)
-    for (int ch = 0; ch < 3; ++ch) {
-      const double se2 = v.se2[i][ch] + c.se2[i][ch], d = v.mean[i][ch] - c.mean[i][ch];
-      if (!(se2 > 0.0)) {
-        if (std::abs(d) > 1e-6 * std::max(1.0, std::abs(c.mean[i][ch]))) ++a.exactMismatches;
-        continue;
-      }
-      const double z = d / std::sqrt(se2);
-      ++a.samples;
-      a.meanZ += z;
-      a.meanZ2 += std::min(z * z, 25.0);
-      if (std::abs(z) > 4.0) a.beyond4 += 1.0;
-      if (std::abs(z) > worst) {
-        worst = std::abs(z);
-        char buf[160];
-        std::snprintf(buf, sizeof buf, "pixel (%d, %d) channel %d: vplview %.5g, Cycles %.5g, z %.2f", int(i) % kWidth,
-                      int(i) / kWidth, ch, v.mean[i][ch], c.mean[i][ch], z);
-        a.worst = buf;
-      }
-    }
-  if (a.samples > 0) {
-    a.meanZ /= a.samples;
-    a.meanZ2 /= a.samples;
-    a.beyond4 /= a.samples;
-  }
-  for (int ch = 0; ch < 3; ++ch) {
-    a.relDiff[ch] = (v.imageMean[ch] - c.imageMean[ch]) / c.imageMean[ch];
-    a.relSe[ch] = std::sqrt(v.imageSe2[ch] + c.imageSe2[ch]) / c.imageMean[ch];
-    a.imageZ = std::max(a.imageZ, std::abs(a.relDiff[ch]) / a.relSe[ch]);
-  }
-  return a;
-}
 
 // The bounds, for two unbiased estimates. With kBatches = 16 vplview batches (and Cycles' standard
 // error, from 8 seeds, a small part of the sum: its 131072 spp against vplview's few thousand), z is
@@ -147,9 +65,12 @@ Agreement compare(const Estimate& v, const Estimate& c) {
 // What they catch (each tried as a scratch edit): Lambert x0.99 fails all 8 cases (mean z -0.8 to
 // -1.3, image -0.6 to -3.3 %); guide pdf x1.05 fails the 6 guided ones; a ninth path segment fails
 // the 4 two_rooms cases (+1.8 to +3.8 %).
-struct Bounds {
-  double meanZ = 0.25, meanZ2 = 1.6, beyond4 = 0.01, imageZ = 5.0;
-};
+// - Image mean of two_rooms: besides 5 standard errors, 0.3 % for what the two renderers model
+//   differently (the known residual above: Cycles 3.4 is 1.6-6.9 % dark where an area lamp lights at
+//   grazing emission angles). With stratified samples the image means' standard errors fall to
+//   0.05-0.1 %, below that residual. The Cornell box has no such allowance: it agreed to 0.00 +- 0.05 %.
+constexpr test::AgreementBounds kBounds{5.0, 1.6, 0.01, 0.25};
+constexpr double kTwoRoomsResidual = 0.003;
 
 constexpr int kBatches = 16;
 
@@ -168,7 +89,7 @@ void PrintTo(const Case& c, std::ostream* os) {
   *os << caseName(c) << " (" << kBatches << " x " << c.sppPerBatch << " spp)";
 }
 
-Estimate cyclesReference(const std::string& scene) {
+test::BatchEstimate cyclesReference(const std::string& scene) {
   std::vector<Image> images;
   for (int seed = 1; seed <= kCyclesSeeds; ++seed) {
     const std::string path =
@@ -184,10 +105,10 @@ Estimate cyclesReference(const std::string& scene) {
       return {};
     }
   }
-  return estimate(images);
+  return test::estimateFromBatches(images);
 }
 
-Estimate renderVplview(const Case& c) {
+test::BatchEstimate renderVplview(const Case& c) {
   const SceneData data = loadGltf(test::sourceDir() + "/scenes/" + c.scene + ".gltf");
   std::vector<Image> images;
   uint64_t discarded = 0, guideSamples = 0;
@@ -207,32 +128,20 @@ Estimate renderVplview(const Case& c) {
   }
   EXPECT_EQ(discarded, 0u) << "non-finite or negative samples";
   if (c.mode != SamplingMode::Brdf) EXPECT_GT(guideSamples, 0u) << "the guide was never used";
-  return estimate(images);
+  return test::estimateFromBatches(images);
 }
 
 class CyclesAnchor : public ::testing::TestWithParam<Case> {};
 
 TEST_P(CyclesAnchor, AgreesWithCyclesPixelByPixel) {
   const Case c = GetParam();
-  const Estimate cycles = cyclesReference(c.scene);
-  if (cycles.count == 0) return;
-  const Estimate vplview = renderVplview(c);
-  const Agreement a = compare(vplview, cycles);
-  const Bounds bounds;
-  std::printf("[cycles] %-22s mean z %+.3f  mean z^2 %.3f  beyond 4 sigma %.2f %%  image mean rel. diff. "
-              "(%+.4f, %+.4f, %+.4f) +- (%.4f, %.4f, %.4f)  worst %s\n",
-              caseName(c).c_str(), a.meanZ, a.meanZ2, 100.0 * a.beyond4, a.relDiff.x, a.relDiff.y, a.relDiff.z,
-              a.relSe.x, a.relSe.y, a.relSe.z, a.worst.c_str());
-  const std::string what = caseName(c) + " against Cycles (worst " + a.worst + ")";
-  EXPECT_GT(a.samples, kWidth * kHeight * 3 / 2) << what << ": too few noisy pixels to judge";
-  EXPECT_EQ(a.exactMismatches, 0) << what;
-  EXPECT_LT(std::abs(a.meanZ), bounds.meanZ) << what << ": a bias of one sign over the image";
-  EXPECT_LT(a.meanZ2, bounds.meanZ2) << what << ": more spread than noise explains";
-  EXPECT_LT(a.beyond4, bounds.beyond4) << what << ": too many pixels beyond 4 sigma";
-  for (int ch = 0; ch < 3; ++ch)
-    EXPECT_LT(std::abs(a.relDiff[ch]), bounds.imageZ * a.relSe[ch])
-        << what << ": image mean of channel " << ch << " differs by " << 100.0 * a.relDiff[ch] << " % (standard error "
-        << 100.0 * a.relSe[ch] << " %)";
+  const test::BatchEstimate cycles = cyclesReference(c.scene);
+  if (cycles.batches == 0) return;
+  const test::Agreement a = test::compareEstimates(renderVplview(c), cycles);
+  EXPECT_GT(a.samples, kWidth * kHeight * 3 / 2) << caseName(c) << ": too few noisy pixels to judge";
+  test::AgreementBounds bounds = kBounds;
+  if (std::string(c.scene) == "two_rooms") bounds.imageFloor = kTwoRoomsResidual;
+  test::expectAgreement(a, "[cycles] " + caseName(c), bounds);
 }
 
 INSTANTIATE_TEST_SUITE_P(
