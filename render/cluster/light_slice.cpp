@@ -160,7 +160,7 @@ LightSliceResult clusterLightSlice(std::span<const Vpl> vpls, std::span<const Ga
   // 1. Reduced light matrix: rows at evenly spread slices (a seeded stride through the slices).
   const uint32_t rowCount = std::min<uint32_t>(uint32_t(settings.reducedRows), sliceCount);
   std::vector<uint32_t> rowSlice(rowCount);
-  Rng rowRng(settings.seed, 0x726f7773ull);
+  Rng rowRng = Rng::hashed(mix64(settings.seed) ^ 0x726f7773ull);
   const double stride = double(sliceCount) / rowCount;
   for (uint32_t r = 0; r < rowCount; ++r)
     rowSlice[r] = std::min(sliceCount - 1, uint32_t((r + rowRng.uniform()) * stride));
@@ -183,7 +183,7 @@ LightSliceResult clusterLightSlice(std::span<const Vpl> vpls, std::span<const Ga
   std::vector<uint32_t> seeds;
   {
     const Distribution1D byNorm(norms);
-    Rng rng(settings.seed, 0x73656564ull);
+    Rng rng = Rng::hashed(mix64(settings.seed) ^ 0x73656564ull);
     std::vector<bool> taken(n, false);
     const int wanted = std::min(settings.globalClusters, settings.clusterBudget);
     for (int k = 0; k < 4 * wanted && int(seeds.size()) < wanted && !byNorm.empty(); ++k) {
@@ -266,7 +266,7 @@ LightSliceResult clusterLightSlice(std::span<const Vpl> vpls, std::span<const Ga
     // Representatives by power, and their estimated contribution (with visibility) at this slice.
     SliceClusters& out = result.slices[s];
     out.clusters.resize(clusters.size());
-    Rng rng(settings.seed ^ 0x636c7573ull, s);
+    Rng rng = Rng::hashed(mix64(settings.seed ^ 0x636c7573ull) ^ s);  // hashed: per-slice streams must not share a state
     uint64_t evals = n;
     for (size_t c = 0; c < clusters.size(); ++c) {
       VplCluster& cl = out.clusters[c];

@@ -1,5 +1,7 @@
-// PCG32 random numbers. Every sample owns a stream derived from (seed, pixel, sample index), so an
-// image is the same for any thread count or tile order (pbrt-v4's rule).
+// PCG32 random numbers: the independent random fallback of the sampler (pixel_sampler.h) for decisions
+// past its tabulated dimensions, and the stream of consumers that need an unbounded count of numbers
+// (Metropolis mutations, light paths, clustering). Streams are derived from hashed keys, so results
+// are the same for any thread count or tile order (pbrt-v4's rule).
 #pragma once
 #include <cstdint>
 #include <glm/glm.hpp>
@@ -23,9 +25,19 @@ class Rng {
     state_ += seed;
     next();
   }
+  // A stream whose state and increment both come from a strong hash of `key`. Streams that share a
+  // state and differ only in the increment are correlated (Vigna's critique of PCG), so derived
+  // streams (per sample, per light path, per slice) should be made by this, not Rng(seed, index).
+  static Rng hashed(uint64_t key) {
+    Rng r;
+    r.inc_ = (mix64(key ^ 0x243f6a8885a308d3ull) << 1u) | 1u;
+    r.state_ = mix64(key);
+    r.next();
+    return r;
+  }
   // The stream of one pixel sample: deterministic in (seed, pixel, sampleIndex) only.
   static Rng forSample(uint64_t seed, uint64_t pixel, uint64_t sampleIndex) {
-    return Rng(mix64(seed ^ mix64(pixel)), mix64(sampleIndex ^ (seed << 17)));
+    return hashed(mix64(mix64(seed) ^ pixel) ^ mix64(sampleIndex ^ 0x5851f42d4c957f2dull));
   }
 
   uint32_t next() {

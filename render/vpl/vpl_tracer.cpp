@@ -22,7 +22,8 @@ struct PathResult {
 
 // One light path; VPL fluxes are left un-normalised (divided by the path count at the end).
 void traceLightPath(const RenderScene& scene, const VplSettings& settings, uint64_t pathIndex, PathResult& out) {
-  Rng rng(settings.seed ^ 0x5bd1e995ull, pathIndex);
+  // A light path takes an unbounded count of numbers: its own hashed random stream.
+  Rng rng = Rng::hashed(mix64(settings.seed ^ 0x5bd1e995ull) ^ pathIndex);
   const float uLight = rng.uniform();
   const glm::vec2 uPos = rng.uniform2(), uDir = rng.uniform2();
   const auto emission = scene.emitters().sampleEmission(uLight, uPos, uDir);
