@@ -33,14 +33,14 @@ class RectangleContinuation final : public ContinuationSampler {
  public:
   explicit RectangleContinuation(const Rectangle& r) : rect_(r), normal_(r.normal()) {}
 
-  bool sample(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, Rng& rng, DirectionSample& out,
+  bool sample(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, VertexSamples& samples, DirectionSample& out,
               PathStats& stats) override {
-    if (!faces(hit) || rng.uniform() < 0.5f) {
-      const auto s = bsdf.sample(wo, rng.uniform2(), rng.uniform());
+    if (!faces(hit) || samples.strategy() < 0.5f) {
+      const auto s = bsdf.sample(wo, samples.bsdfDirection(), samples.bsdfLobe());
       if (!s) return false;
       out.wi = s->wi;
     } else {
-      const glm::vec2 u = rng.uniform2() * 2.0f - 1.0f;
+      const glm::vec2 u = samples.guidePoint() * 2.0f - 1.0f;
       out.wi = glm::normalize(rect_.centre + u.x * rect_.u + u.y * rect_.v - hit.position);
     }
     ++stats.bsdfSamples;

@@ -109,17 +109,15 @@ float GuideDistribution::pdf(const glm::vec3& w) const {
   return cellDensity_ * choice_.pmf(size_t(cellOf(w))) + defensive_ * uniformSpherePdf();
 }
 
-glm::vec3 GuideDistribution::sample(Rng& rng) const {
-  const float u = rng.uniform();
-  const glm::vec2 u2 = rng.uniform2();
-  if (choice_.empty() || u < defensive_) return sampleUniformSphere(u2);
-  // Reuse u: it picks the cell after the defensive branch.
-  const float uPick = std::min((u - defensive_) / (1.0f - defensive_), 0x1.fffffep-1f);
+glm::vec3 GuideDistribution::sample(float uCell, glm::vec2 uPoint) const {
+  if (choice_.empty() || uCell < defensive_) return sampleUniformSphere(uPoint);
+  // Reuse uCell: it picks the cell after the defensive branch.
+  const float uPick = std::min((uCell - defensive_) / (1.0f - defensive_), 0x1.fffffep-1f);
   const int cell = int(choice_.sample(uPick));
   // Keep the point strictly inside its cell, so that cellOf() gives the cell back.
   constexpr float kInside = 0x1.fffffep-1f;
-  const glm::vec2 p((float(cell % kResolution) + u2.x * kInside) / float(kResolution),
-                    (float(cell / kResolution) + u2.y * kInside) / float(kResolution));
+  const glm::vec2 p((float(cell % kResolution) + uPoint.x * kInside) / float(kResolution),
+                    (float(cell / kResolution) + uPoint.y * kInside) / float(kResolution));
   return equalAreaSquareToSphere(p);
 }
 

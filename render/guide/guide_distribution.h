@@ -38,7 +38,12 @@ class GuideDistribution {
   float target(const glm::vec3& w) const { return float(choice_.pmf(size_t(cellOf(w))) * total_ / kCellSolidAngle); }
   // Density of sample() per solid angle (includes the defensive term).
   float pdf(const glm::vec3& w) const;
-  glm::vec3 sample(Rng& rng) const;
+  // uCell picks the defensive share or a cell, uPoint the point in the cell.
+  glm::vec3 sample(float uCell, glm::vec2 uPoint) const;
+  glm::vec3 sample(Rng& rng) const {
+    const float u = rng.uniform();
+    return sample(u, rng.uniform2());
+  }
 
   double totalWeight() const { return total_; }
   size_t size() const { return representativeCount_; }

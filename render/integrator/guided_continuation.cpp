@@ -37,14 +37,13 @@ int GuidedContinuation::servingCachePoint(const SurfaceHit& hit, const Bsdf& bsd
   return bsdf.isNearSpecular() ? -1 : c;
 }
 
-bool GuidedContinuation::sample(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, Rng& rng,
+bool GuidedContinuation::sample(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, VertexSamples& u,
                                 DirectionSample& out, PathStats& stats) {
   const int c = servingCachePoint(hit, bsdf);
   const float pBsdf = c < 0 ? 1.0f : bsdfProbability();
-  const float uStrategy = rng.uniform();
-  if (uStrategy < pBsdf) {
-    const float uLobe = rng.uniform();
-    const auto s = bsdf.sample(wo, rng.uniform2(), uLobe);
+  // Only a real choice draws a number: the strategy dimension stays unused where one strategy is certain.
+  if (pBsdf >= 1.0f || (pBsdf > 0.0f && u.strategy() < pBsdf)) {
+    const auto s = bsdf.sample(wo, u.bsdfDirection(), u.bsdfLobe());
     if (!s) return false;
     out.wi = s->wi;
     ++stats.bsdfSamples;
@@ -52,13 +51,15 @@ bool GuidedContinuation::sample(const SurfaceHit& hit, const Bsdf& bsdf, const g
     const GuideDistribution& guide = field_.point(c).distribution;
     const bool revisit = std::find(chainsUsedByPath_.begin(), chainsUsedByPath_.end(), c) != chainsUsedByPath_.end();
     if (mode_ == SamplingMode::Mixture || revisit) {
-      out.wi = guide.sample(rng);
+      out.wi = guide.sample(u.guideCell(), u.guidePoint());
     } else {
+      // A Markov chain's states are not stratified samples: its start and mutations use the
+      // vertex's random stream.
       chainsUsedByPath_.push_back(c);
       auto it = chains_.find(c);
-      if (it == chains_.end()) it = chains_.emplace(c, MetropolisChain(guide, rng)).first;
+      if (it == chains_.end()) it = chains_.emplace(c, MetropolisChain(guide, u.random())).first;
       ChainStats chain;
-      out.wi = it->second.next(guide, field_.settings(), rng, chain);
+      out.wi = it->second.next(guide, field_.settings(), u.random(), chain);
       stats.proposals += chain.proposals;
       stats.accepted += chain.accepted;
     }

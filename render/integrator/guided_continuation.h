@@ -18,7 +18,7 @@ class GuidedContinuation final : public ContinuationSampler {
  public:
   GuidedContinuation(const GuideField& field, SamplingMode mode) : field_(field), mode_(mode) {}
 
-  bool sample(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, Rng& rng, DirectionSample& out,
+  bool sample(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, VertexSamples& u, DirectionSample& out,
               PathStats& stats) override;
   float pdf(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, const glm::vec3& wi) override;
   void beginPath(uint64_t pixel) override {

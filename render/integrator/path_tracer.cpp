@@ -12,10 +12,9 @@ std::string PathTracerSettings::validate() const {
   return {};
 }
 
-bool BsdfContinuation::sample(const SurfaceHit&, const Bsdf& bsdf, const glm::vec3& wo, Rng& rng,
+bool BsdfContinuation::sample(const SurfaceHit&, const Bsdf& bsdf, const glm::vec3& wo, VertexSamples& u,
                               DirectionSample& out, PathStats& stats) {
-  const float uLobe = rng.uniform();
-  const auto s = bsdf.sample(wo, rng.uniform2(), uLobe);
+  const auto s = bsdf.sample(wo, u.bsdfDirection(), u.bsdfLobe());
   if (!s || !(s->pdf > 0.0f)) return false;
   ++stats.bsdfSamples;
   out.wi = s->wi;
@@ -27,7 +26,7 @@ float BsdfContinuation::pdf(const SurfaceHit&, const Bsdf& bsdf, const glm::vec3
   return bsdf.pdf(wo, wi);
 }
 
-glm::vec3 PathTracer::radiance(const Ray& cameraRay, Rng& rng, ContinuationSampler& continuation,
+glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, ContinuationSampler& continuation,
                                PathStats& stats, uint64_t pixel) const {
   const EmitterSet& emitters = scene_.emitters();
   continuation.beginPath(pixel);
@@ -60,9 +59,10 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, Rng& rng, ContinuationSampl
     if (depth + 1 > settings_.maxDepth) break;
 
     const Bsdf bsdf = scene_.bsdf(surface);
+    VertexSamples u(sampler, depth);
 
     // Next-event estimation: one light sample, MIS with the continuation strategy.
-    if (const auto ls = emitters.sample(surface.position, rng.uniform(), rng.uniform2())) {
+    if (const auto ls = emitters.sample(surface.position, u.lightChoice(), u.lightPoint())) {
       const glm::vec3 f = bsdf.eval(wo, ls->wi);
       if (!isBlack(f) && glm::dot(ls->wi, surface.geometricNormal) > 0.0f) {
         ++stats.rays;
@@ -75,7 +75,7 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, Rng& rng, ContinuationSampl
 
     // Continuation direction.
     DirectionSample next;
-    if (!continuation.sample(surface, bsdf, wo, rng, next, stats)) break;
+    if (!continuation.sample(surface, bsdf, wo, u, next, stats)) break;
     const glm::vec3 f = bsdf.eval(wo, next.wi);
     if (isBlack(f) || glm::dot(next.wi, surface.geometricNormal) <= 0.0f) break;
     beta *= f / next.pdf;
@@ -84,7 +84,7 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, Rng& rng, ContinuationSampl
     // Russian roulette on the throughput (after a few bounces, so short paths keep full weight).
     if (depth + 1 >= settings_.rrStartDepth) {
       const float survive = std::min(1.0f, maxComponent(beta));
-      if (rng.uniform() >= survive) break;
+      if (u.roulette() >= survive) break;
       beta /= survive;
     }
     previous = surface;

@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <string>
 #include <glm/glm.hpp>
-#include "render/sampling/rng.h"
+#include "render/sampling/pixel_sampler.h"
 #include "render/scene/render_scene.h"
 
 namespace vpl {
@@ -41,8 +41,8 @@ class ContinuationSampler {
   virtual ~ContinuationSampler() = default;
   // Called at the start of every camera path, with its pixel (row-major index).
   virtual void beginPath(uint64_t /*pixel*/) {}
-  // Picks a direction at this vertex; returns false when the path should end.
-  virtual bool sample(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, Rng& rng,
+  // Picks a direction at this vertex from its numbers `u`; returns false when the path should end.
+  virtual bool sample(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, VertexSamples& u,
                       DirectionSample& out, PathStats& stats) = 0;
   // Density with which sample() would return wi at this vertex.
   virtual float pdf(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, const glm::vec3& wi) = 0;
@@ -51,7 +51,7 @@ class ContinuationSampler {
 // Plain BSDF importance sampling (the `brdf` mode).
 class BsdfContinuation final : public ContinuationSampler {
  public:
-  bool sample(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, Rng& rng, DirectionSample& out,
+  bool sample(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, VertexSamples& u, DirectionSample& out,
               PathStats& stats) override;
   float pdf(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, const glm::vec3& wi) override;
 };
@@ -60,9 +60,16 @@ class PathTracer {
  public:
   PathTracer(const RenderScene& scene, const PathTracerSettings& settings) : scene_(scene), settings_(settings) {}
 
-  // Radiance arriving along the camera ray. May be non-finite only through a bug; callers check.
-  glm::vec3 radiance(const Ray& cameraRay, Rng& rng, ContinuationSampler& continuation, PathStats& stats,
+  // Radiance arriving along the camera ray, every decision drawn from its dimension of `sampler`.
+  // May be non-finite only through a bug; callers check.
+  glm::vec3 radiance(const Ray& cameraRay, PixelSampler& sampler, ContinuationSampler& continuation, PathStats& stats,
                      uint64_t pixel = 0) const;
+  // The same with independent random numbers from `rng` (benches that trace paths of their own).
+  glm::vec3 radiance(const Ray& cameraRay, Rng& rng, ContinuationSampler& continuation, PathStats& stats,
+                     uint64_t pixel = 0) const {
+    PixelSampler independent(rng);
+    return radiance(cameraRay, independent, continuation, stats, pixel);
+  }
 
   const PathTracerSettings& settings() const { return settings_; }
 

@@ -10,8 +10,8 @@ PixelShaderFactory pathTracerShader(const PathTracer& tracer, ContinuationFactor
   if (!continuation) continuation = [](uint32_t, uint64_t) { return std::make_unique<BsdfContinuation>(); };
   return [&tracer, continuation](uint32_t tile, uint64_t pass) -> PixelShader {
     std::shared_ptr<ContinuationSampler> strategy = continuation(tile, pass);
-    return [&tracer, strategy](const Ray& ray, uint64_t pixel, Rng& rng, PathStats& stats) {
-      return tracer.radiance(ray, rng, *strategy, stats, pixel);
+    return [&tracer, strategy](const Ray& ray, uint64_t pixel, PixelSampler& sampler, PathStats& stats) {
+      return tracer.radiance(ray, sampler, *strategy, stats, pixel);
     };
   };
 }
@@ -33,10 +33,9 @@ PassStats TileRenderer::renderPass(Film& film, uint64_t pass, const std::atomic<
     for (int y = y0; y < y1; ++y)
       for (int x = x0; x < x1; ++x) {
         const uint64_t pixel = uint64_t(y) * uint64_t(width) + uint64_t(x);
-        Rng rng = Rng::forSample(seed_, pixel, pass);
-        const glm::vec2 jitter = rng.uniform2();
-        const Ray ray = camera_.generateRay(glm::vec2(float(x), float(y)) + jitter);
-        const glm::vec3 L = shade(ray, pixel, rng, path);
+        PixelSampler sampler(seed_, pixel, pass);
+        const Ray ray = camera_.generateRay(glm::vec2(float(x), float(y)) + sampler.cameraJitter());
+        const glm::vec3 L = shade(ray, pixel, sampler, path);
         ++stats.samples;
         if (!isFiniteNonNegative(L)) {
           ++stats.discarded;

@@ -1,5 +1,7 @@
 // One progressive pass = one sample in every pixel, rendered in 16x16 tiles over the TBB pool.
-// Samples are deterministic in (seed, pixel, pass): the image does not depend on thread count.
+// The pass number is the pixels' sample index: samples are deterministic in (seed, pixel, pass), so
+// the image does not depend on thread count, and each pixel's passes 0, 1, 2, ... walk one
+// stratified sequence (render/sampling/pixel_sampler.h). Callers never reuse a pass number for a film.
 #pragma once
 #include <atomic>
 #include <cstdint>
@@ -26,7 +28,7 @@ struct PassStats {
 };
 
 // Radiance along one camera ray of pixel `pixel` (row-major index).
-using PixelShader = std::function<glm::vec3(const Ray& ray, uint64_t pixel, Rng& rng, PathStats& stats)>;
+using PixelShader = std::function<glm::vec3(const Ray& ray, uint64_t pixel, PixelSampler& sampler, PathStats& stats)>;
 // Makes the shader of one tile and pass. Each tile gets its own, so per-tile state (such as Markov
 // chains) is deterministic and never shared between threads.
 using PixelShaderFactory = std::function<PixelShader(uint32_t tileIndex, uint64_t pass)>;

@@ -50,9 +50,9 @@ class SliceTransport final : public LightTransport {
 };
 
 // One emitter sample, unweighted: the preview has no BSDF-sampled light to combine it with.
-glm::vec3 directLight(const RenderScene& scene, const SurfaceHit& surface, const Bsdf& bsdf, const glm::vec3& wo, Rng& rng,
-                      PathStats& stats) {
-  const auto ls = scene.emitters().sample(surface.position, rng.uniform(), rng.uniform2());
+glm::vec3 directLight(const RenderScene& scene, const SurfaceHit& surface, const Bsdf& bsdf, const glm::vec3& wo,
+                      VertexSamples u, PathStats& stats) {
+  const auto ls = scene.emitters().sample(surface.position, u.lightChoice(), u.lightPoint());
   if (!ls) return glm::vec3(0.0f);
   const glm::vec3 f = bsdf.eval(wo, ls->wi);
   if (isBlack(f) || glm::dot(ls->wi, surface.geometricNormal) <= 0.0f) return glm::vec3(0.0f);
@@ -63,14 +63,14 @@ glm::vec3 directLight(const RenderScene& scene, const SurfaceHit& surface, const
 // What a near-specular surface shows: its BSDF followed (a few bounces) to the first rough surface,
 // which gets emission and direct light (light sampling alone cannot find a lobe a few degrees wide,
 // and VPLs would light it in spikes).
-glm::vec3 reflectedLight(const RenderScene& scene, SurfaceHit surface, Bsdf bsdf, glm::vec3 wo, Rng& rng,
+glm::vec3 reflectedLight(const RenderScene& scene, SurfaceHit surface, Bsdf bsdf, glm::vec3 wo, PixelSampler& sampler,
                          PathStats& stats) {
   constexpr int kSpecularBounces = 8;
   const EmitterSet& emitters = scene.emitters();
   glm::vec3 L(0.0f), beta(1.0f);
   for (int bounce = 0; bounce < kSpecularBounces; ++bounce) {
-    const float uLobe = rng.uniform();
-    const auto next = bsdf.sample(wo, rng.uniform2(), uLobe);
+    VertexSamples u(sampler, bounce);
+    const auto next = bsdf.sample(wo, u.bsdfDirection(), u.bsdfLobe());
     if (!next || glm::dot(next->wi, surface.geometricNormal) <= 0.0f) break;
     beta *= next->weight;
     const Ray ray = spawnRay(surface, next->wi);
@@ -81,7 +81,7 @@ glm::vec3 reflectedLight(const RenderScene& scene, SurfaceHit surface, Bsdf bsdf
     wo = -ray.direction;
     L += beta * emitters.emitted(surface, wo);
     bsdf = scene.bsdf(surface);
-    if (!bsdf.isNearSpecular()) return L + beta * directLight(scene, surface, bsdf, wo, rng, stats);
+    if (!bsdf.isNearSpecular()) return L + beta * directLight(scene, surface, bsdf, wo, VertexSamples(sampler, bounce + 1), stats);
   }
   return L;
 }
@@ -119,7 +119,7 @@ VplField buildVplField(const RenderScene& scene, const Camera& camera, std::shar
 PixelShaderFactory previewShader(const RenderScene& scene, const VplField& field, const PreviewSettings& settings) {
   const int m = settings.clustersPerPass;
   return [&scene, &field, m](uint32_t, uint64_t) -> PixelShader {
-    return [&scene, &field, m](const Ray& ray, uint64_t pixel, Rng& rng, PathStats& stats) -> glm::vec3 {
+    return [&scene, &field, m](const Ray& ray, uint64_t pixel, PixelSampler& sampler, PathStats& stats) -> glm::vec3 {
       const EmitterSet& emitters = scene.emitters();
       const RayHit hit = scene.accel().intersect(ray);
       ++stats.rays;
@@ -128,8 +128,8 @@ PixelShaderFactory previewShader(const RenderScene& scene, const VplField& field
       const glm::vec3 wo = -ray.direction;
       glm::vec3 L = emitters.emitted(surface, wo);
       const Bsdf bsdf = scene.bsdf(surface);
-      if (bsdf.isNearSpecular()) return L + reflectedLight(scene, surface, bsdf, wo, rng, stats);
-      L += directLight(scene, surface, bsdf, wo, rng, stats);
+      if (bsdf.isNearSpecular()) return L + reflectedLight(scene, surface, bsdf, wo, sampler, stats);
+      L += directLight(scene, surface, bsdf, wo, VertexSamples(sampler, 0), stats);
 
       // Indirect light: clusters of the pixel's slice, sampled by estimated contribution.
       const int32_t g = pixel < field.gather.pixelGather.size() ? field.gather.pixelGather[pixel] : -1;
@@ -138,9 +138,13 @@ PixelShaderFactory previewShader(const RenderScene& scene, const VplField& field
       const Distribution1D& choice = field.clusterChoice[s];
       if (choice.empty()) return L;
       const auto& clusters = field.clusters.slices[s].clusters;
+      // Systematic sampling: the m picks sit at (i + u) / m of the choice's CDF, one in each m-th of
+      // it. Each pick alone is distributed by the choice (so the sum stays unbiased), and u itself
+      // is stratified across passes.
+      const float u = sampler.previewClusters();
       for (int i = 0; i < m; ++i) {
         float pmf = 0.0f;
-        const VplCluster& c = clusters[choice.sample(rng.uniform(), &pmf)];
+        const VplCluster& c = clusters[choice.sample((float(i) + u) / float(m), &pmf)];
         const Vpl& light = field.vpls->vpls[c.representative];
         const float repPower = light.power();
         if (!(repPower > 0.0f)) continue;

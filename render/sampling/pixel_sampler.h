@@ -1,0 +1,122 @@
+// The numbers of one pixel sample, each random decision on its own dimension (DESIGN.md §2 step 8).
+//
+// A sample is (seed, pixel, index), the index counting the pixel's samples from 0 and never
+// restarting, so the image depends on nothing else (not threads, not tile order). Each decision
+// has a fixed slot: one Sobol' 1D or 2D stream of sobol.h, shuffled and Owen-scrambled by a hash of
+// (seed, pixel, slot). The first 2^m samples of any slot in a pixel are stratified (one per
+// elementary interval), different slots and pixels are independent of each other.
+//
+// Slot layout: the camera jitter, the preview's cluster choice, then per path vertex (its depth:
+// 0 is the camera ray's hit) a block of VertexDimension. Past kTabulatedVertices, and for consumers
+// of an unbounded count of numbers (Metropolis mutations), numbers come from a hash of
+// (seed, pixel, index, slot): independent random, no worse than before.
+#pragma once
+#include <cstdint>
+#include <optional>
+#include <glm/glm.hpp>
+#include "render/sampling/rng.h"
+#include "render/sampling/sobol.h"
+
+namespace vpl {
+
+// The decisions at one path vertex. The 2D ones take one slot each, like the 1D ones.
+enum class VertexDimension : uint32_t {
+  LightChoice,     // 1D: which emitter (next-event estimation)
+  LightPoint,      // 2D: the point on it
+  BsdfLobe,        // 1D: diffuse or specular lobe
+  BsdfDirection,   // 2D: the direction within the lobe
+  Strategy,        // 1D: BSDF or guide (one-sample MIS)
+  GuideCell,       // 1D: the guide's cell (or its defensive uniform share)
+  GuidePoint,      // 2D: the point within that cell
+  Roulette,        // 1D: Russian roulette
+  Count
+};
+
+class PixelSampler {
+ public:
+  static constexpr int kTabulatedVertices = 8;
+
+  PixelSampler(uint64_t seed, uint64_t pixel, uint64_t sampleIndex)
+      : pixelKey_(mix64(mix64(seed ^ 0x736f626f6c000000ull) ^ pixel) ^ mix64(sampleIndex >> 32)),
+        sampleKey_(mix64(pixelKey_ ^ sampleIndex)),
+        reversedIndex_(sobol::reverseBits(uint32_t(sampleIndex))) {}
+  // Independent random numbers, all from `rng` in the order asked: for callers that bring their own
+  // stream (benches, and as the baseline the stratified samples are measured against).
+  explicit PixelSampler(Rng& rng) : independent_(&rng) {}
+
+  glm::vec2 cameraJitter() { return get2D(kCameraSlot); }
+  float previewClusters() { return get1D(kPreviewClusterSlot); }
+
+  float get1D(int vertex, VertexDimension d) {
+    const uint32_t slot = slotOf(vertex, d);
+    return vertex < kTabulatedVertices || independent_ ? get1D(slot) : hashedUniform(slot, 0);
+  }
+  glm::vec2 get2D(int vertex, VertexDimension d) {
+    const uint32_t slot = slotOf(vertex, d);
+    return vertex < kTabulatedVertices || independent_ ? get2D(slot) : glm::vec2(hashedUniform(slot, 0), hashedUniform(slot, 1));
+  }
+  // A stream of its own for a vertex's consumer of an unbounded count of numbers.
+  Rng random(int vertex) {
+    if (independent_) return Rng::hashed(independent_->next() | uint64_t(independent_->next()) << 32);
+    return Rng::hashed(sampleKey_ ^ (0x72616e646f6d0000ull + uint64_t(vertex)));
+  }
+
+ private:
+  static constexpr uint32_t kCameraSlot = 0, kPreviewClusterSlot = 1, kFirstVertexSlot = 2;
+  static uint32_t slotOf(int vertex, VertexDimension d) {
+    return kFirstVertexSlot + uint32_t(vertex) * uint32_t(VertexDimension::Count) + uint32_t(d);
+  }
+
+  // One hash of (pixel, slot) gives the slot's shuffle and its scrambles.
+  float get1D(uint32_t slot) const {
+    if (independent_) return independent_->uniform();
+    const uint64_t h = mix64(pixelKey_ + slot);
+    const uint32_t i = shuffledIndex(uint32_t(h));
+    return sobol::toUnitFloat(sobol::scrambledVanDerCorput(i, uint32_t(h >> 32)));
+  }
+  glm::vec2 get2D(uint32_t slot) const {
+    if (independent_) return independent_->uniform2();
+    const uint64_t h = mix64(pixelKey_ + slot), h2 = mix64(h);
+    const uint32_t i = shuffledIndex(uint32_t(h));
+    return {sobol::toUnitFloat(sobol::scrambledVanDerCorput(i, uint32_t(h >> 32))),
+            sobol::toUnitFloat(sobol::scrambledSobolSecond(i, uint32_t(h2)))};
+  }
+  // sobol::shuffleIndex(index, seed), its first bit reversal done once per sample.
+  uint32_t shuffledIndex(uint32_t seed) const { return sobol::reverseBits(sobol::nestedScrambleReversed(reversedIndex_, seed)); }
+  float hashedUniform(uint32_t slot, uint32_t component) const {
+    return float(mix64(sampleKey_ + 2u * uint64_t(slot) + component) >> 40) * 0x1p-24f;
+  }
+
+  uint64_t pixelKey_ = 0;   // hash of (seed, pixel, the index's high half): the slots' scrambles
+  uint64_t sampleKey_ = 0;  // hash of that and the whole index: the random fallback
+  uint32_t reversedIndex_ = 0;  // the index's low 32 bits, bit-reversed
+  Rng* independent_ = nullptr;
+};
+
+// The numbers of one path vertex: handed to whoever decides something there.
+class VertexSamples {
+ public:
+  VertexSamples(PixelSampler& sampler, int vertex) : sampler_(sampler), vertex_(vertex) {}
+
+  int vertex() const { return vertex_; }
+  float lightChoice() { return sampler_.get1D(vertex_, VertexDimension::LightChoice); }
+  glm::vec2 lightPoint() { return sampler_.get2D(vertex_, VertexDimension::LightPoint); }
+  float bsdfLobe() { return sampler_.get1D(vertex_, VertexDimension::BsdfLobe); }
+  glm::vec2 bsdfDirection() { return sampler_.get2D(vertex_, VertexDimension::BsdfDirection); }
+  float strategy() { return sampler_.get1D(vertex_, VertexDimension::Strategy); }
+  float guideCell() { return sampler_.get1D(vertex_, VertexDimension::GuideCell); }
+  glm::vec2 guidePoint() { return sampler_.get2D(vertex_, VertexDimension::GuidePoint); }
+  float roulette() { return sampler_.get1D(vertex_, VertexDimension::Roulette); }
+  // The vertex's own random stream (Metropolis chains), made on first use.
+  Rng& random() {
+    if (!random_) random_ = sampler_.random(vertex_);
+    return *random_;
+  }
+
+ private:
+  PixelSampler& sampler_;
+  int vertex_;
+  std::optional<Rng> random_;
+};
+
+}  // namespace vpl

@@ -1,0 +1,97 @@
+// The Sobol' (0,2)-sequence with hash-based Owen scrambling: the generator behind every stratified
+// number of the renderer (pixel_sampler.h decides which decision draws from which dimension).
+//
+// Only the first two Sobol' dimensions are used: the van der Corput sequence and its partner whose
+// generator matrix is Pascal's triangle mod 2. Together they form a (0,2)-sequence in base 2: every
+// aligned block of 2^m points is a (0,m,2)-net, one point in each elementary interval of area 2^-m.
+// More dimensions come from "padding" (Kollig & Keller 2002; pbrt-v4's PaddedSobolSampler): every
+// consumer gets its own copy of these two, shuffled and scrambled independently of the others.
+// All values are 0.32 fixed-point fractions until toUnitFloat().
+#pragma once
+#include <array>
+#include <cstdint>
+
+namespace vpl::sobol {
+
+inline uint32_t reverseBits(uint32_t v) {
+  v = __builtin_bswap32(v);
+  v = ((v & 0x0f0f0f0fu) << 4) | ((v >> 4) & 0x0f0f0f0fu);
+  v = ((v & 0x33333333u) << 2) | ((v >> 2) & 0x33333333u);
+  v = ((v & 0x55555555u) << 1) | ((v >> 1) & 0x55555555u);
+  return v;
+}
+
+// First dimension: the base-2 radical inverse of the index.
+inline uint32_t vanDerCorput(uint32_t index) { return reverseBits(index); }
+
+// Direction numbers of the second dimension (primitive polynomial x + 1): v_1 = 1/2 and
+// v_k = v_{k-1} xor v_{k-1} / 2, the rows of Pascal's triangle mod 2. Bit k of the index adds v_{k+1}.
+inline constexpr std::array<uint32_t, 32> kSecondDirections = [] {
+  std::array<uint32_t, 32> d{};
+  uint32_t v = 1u << 31;
+  for (uint32_t& x : d) {
+    x = v;
+    v ^= v >> 1;
+  }
+  return d;
+}();
+
+// The index byte by byte: kSecondByByte[b][x] is the xor of the direction numbers of the bits set
+// in x as byte b of the index (4 KB, made at compile time), four reads instead of a loop over bits.
+// Stored bit-reversed, the form the scramble below works in.
+inline constexpr auto kSecondByByte = [] {
+  std::array<std::array<uint32_t, 256>, 4> table{};
+  for (int b = 0; b < 4; ++b)
+    for (uint32_t x = 0; x < 256; ++x)
+      for (int bit = 0; bit < 8; ++bit)
+        if (x & (1u << bit)) table[size_t(b)][x] ^= kSecondDirections[size_t(8 * b + bit)];
+  for (auto& row : table)
+    for (uint32_t& v : row) {
+      uint32_t r = 0;
+      for (int bit = 0; bit < 32; ++bit) r |= ((v >> bit) & 1u) << (31 - bit);
+      v = r;
+    }
+  return table;
+}();
+
+inline uint32_t reversedSobolSecond(uint32_t index) {
+  return kSecondByByte[0][index & 0xffu] ^ kSecondByByte[1][(index >> 8) & 0xffu] ^
+         kSecondByByte[2][(index >> 16) & 0xffu] ^ kSecondByByte[3][index >> 24];
+}
+inline uint32_t sobolSecond(uint32_t index) { return reverseBits(reversedSobolSecond(index)); }
+
+// Owen's nested uniform scramble (1995) by a hash (Laine & Karras 2011; the multipliers are Vegdahl's
+// 2021 improvement, the hash pbrt-v4 calls FastOwenScrambler). Owen flips each binary digit of the
+// fraction as a random function of the digits before it. With the bits reversed, "before" means
+// "below", and x + c, x * odd and x ^ (x * even) each change a bit only as a function of the bits
+// below it: their composition is such a scramble. It keeps every net a net and makes each point
+// uniformly distributed, so estimates stay unbiased. This is the scramble on reversed bits.
+inline uint32_t nestedScrambleReversed(uint32_t x, uint32_t seed) {
+  x ^= x * 0x3d20adeau;
+  x += seed;
+  x *= (seed >> 16) | 1u;
+  x ^= x * 0x05526c56u;
+  x ^= x * 0x53a22864u;
+  return x;
+}
+inline uint32_t owenScramble(uint32_t v, uint32_t seed) { return reverseBits(nestedScrambleReversed(reverseBits(v), seed)); }
+
+// The scrambled points themselves. The van der Corput point of index i reversed is i itself, so each
+// costs one bit reversal.
+inline uint32_t scrambledVanDerCorput(uint32_t index, uint32_t seed) { return reverseBits(nestedScrambleReversed(index, seed)); }
+inline uint32_t scrambledSobolSecond(uint32_t index, uint32_t seed) {
+  return reverseBits(nestedScrambleReversed(reversedSobolSecond(index), seed));
+}
+
+// A shuffle of the sequence's order (Burley 2020): the same scramble applied to the index itself,
+// most significant bit first. The first 2^m indices, whose high bits are all zero, map to one aligned
+// block of 2^m (the high bits are flipped by a function of zeros only), so every prefix of 2^m
+// shuffled points is still a (0,m,2)-net. Two consumers with different shuffles pair their points
+// at random: that is what decorrelates padded dimensions, and unlike a permutation of a fixed
+// sample count it leaves the sequence open-ended, as progressive rendering needs.
+inline uint32_t shuffleIndex(uint32_t index, uint32_t seed) { return owenScramble(index, seed); }
+
+// [0, 1) from the 24 high bits (a float has 24): never rounds up to 1.
+inline float toUnitFloat(uint32_t v) { return float(v >> 8) * 0x1p-24f; }
+
+}  // namespace vpl::sobol
