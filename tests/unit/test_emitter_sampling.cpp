@@ -1,0 +1,372 @@
+// Emitter sampling: the spherical triangle (solid angle and uniform directions in it) and the alias
+// table that chooses a light by power.
+//
+// Random numbers come from std::mt19937_64 here, not from the renderer's generator, so these tests
+// check the samplers for any uniform input.
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <numbers>
+#include <optional>
+#include <random>
+#include <vector>
+#include "render/sampling/alias_table.h"
+#include "render/sampling/spherical_triangle.h"
+#include "tests/unit/support.h"
+
+namespace vpl {
+namespace {
+
+constexpr double kPiD = std::numbers::pi;
+constexpr double kSignificance = 1e-3;
+
+struct Uniforms {
+  std::mt19937_64 engine;
+  explicit Uniforms(uint64_t seed) : engine(seed) {}
+  float next() { return float(engine() >> 40) * 0x1p-24f; }  // in [0, 1), 24 random bits
+  glm::vec2 next2() {
+    const float a = next();
+    return {a, next()};
+  }
+};
+
+// ---- Independent geometry for the checks -------------------------------------------------------
+struct Triangle {
+  glm::dvec3 v0, v1, v2;
+};
+
+// Barycentrics (b1, b2) and distance t where p + t w meets the plane of tri, not clamped;
+// nullopt when w is parallel to it. (Written out here rather than taken from the renderer.)
+struct PlaneHit {
+  double b1, b2, t;
+};
+std::optional<PlaneHit> hitPlane(const Triangle& tri, const glm::dvec3& p, const glm::dvec3& w) {
+  const glm::dvec3 n = glm::cross(tri.v1 - tri.v0, tri.v2 - tri.v0);
+  const double dn = glm::dot(w, n);
+  if (dn == 0.0) return std::nullopt;
+  const double t = glm::dot(tri.v0 - p, n) / dn;
+  const glm::dvec3 x = p + t * w;
+  // Barycentrics by sub-triangle areas, signed against n.
+  const double area2 = glm::dot(n, n);
+  const double b1 = glm::dot(glm::cross(x - tri.v0, tri.v2 - tri.v0), n) / area2;  // weight of v1
+  const double b2 = glm::dot(glm::cross(tri.v1 - tri.v0, x - tri.v0), n) / area2;  // weight of v2
+  return PlaneHit{b1, b2, t};
+}
+bool hitsTriangle(const Triangle& tri, const glm::dvec3& p, const glm::dvec3& w) {
+  const auto h = hitPlane(tri, p, w);
+  return h && h->t > 0.0 && h->b1 >= 0.0 && h->b2 >= 0.0 && h->b1 + h->b2 <= 1.0;
+}
+
+double solidAngleOf(const Triangle& tri, const glm::dvec3& p) {
+  return triangleSolidAngle(tri.v0 - p, tri.v1 - p, tri.v2 - p);
+}
+
+// Solid angle of the triangle from p by quadrature over its area: the integral of cos / d^2 =
+// h / d^3 (h the distance from p to the plane), by the midpoint rule on k^2 congruent
+// sub-triangles. Independent of the closed form, and it resolves thin and grazing triangles that
+// a grid of directions cannot.
+double solidAngleByQuadrature(const Triangle& tri, const glm::dvec3& p, int k) {
+  const glm::dvec3 e1 = tri.v1 - tri.v0, e2 = tri.v2 - tri.v0;
+  const glm::dvec3 n = glm::normalize(glm::cross(e1, e2));
+  const double h = std::abs(glm::dot(tri.v0 - p, n));
+  const double subArea = 0.5 * glm::length(glm::cross(e1, e2)) / (double(k) * k);
+  double sum = 0.0;
+  auto term = [&](double b1, double b2) {
+    const glm::dvec3 d = tri.v0 + (b1 / k) * e1 + (b2 / k) * e2 - p;
+    const double r2 = glm::dot(d, d);
+    return h / (r2 * std::sqrt(r2));
+  };
+  for (int i = 0; i < k; ++i)
+    for (int j = 0; i + j < k; ++j) {
+      sum += term(i + 1.0 / 3.0, j + 1.0 / 3.0);                         // the sub-triangle with its corner at (i, j)
+      if (i + j <= k - 2) sum += term(i + 2.0 / 3.0, j + 2.0 / 3.0);  // the one turned over
+    }
+  return sum * subArea;
+}
+
+// Chi-square of directions against uniform solid angle, binned by which of k^2 congruent
+// sub-triangles of the planar triangle they hit. A sub-triangle's expected share is its own
+// solid angle over the whole one, so bins follow the triangle however small, thin or grazing it
+// looks. Also checks that every direction hits the triangle (barycentrics within 1e-6).
+test::ChiSquareResult chiSquareOnTriangle(const Triangle& tri, const glm::dvec3& p,
+                                          const std::function<glm::dvec3()>& sample, int sampleCount, int k,
+                                          int* offTriangle) {
+  // Sub-triangle index of barycentrics (b1, b2): the cell (i, j) of the k-grid, then its upper or lower half.
+  auto binOf = [k](double b1, double b2) {
+    const double x = std::clamp(b1, 0.0, 1.0) * k, y = std::clamp(b2, 0.0, 1.0) * k;
+    int i = std::min(int(x), k - 1), j = std::min(int(y), k - 1);
+    if (i + j > k - 1) j = k - 1 - i;
+    const bool upper = (x - i) + (y - j) > 1.0 && i + j <= k - 2;
+    return (i * k + j) * 2 + (upper ? 1 : 0);
+  };
+  const int binCount = 2 * k * k;
+  std::vector<double> observed(binCount + 1, 0.0), expected(binCount + 1, 0.0);
+  *offTriangle = 0;
+  for (int s = 0; s < sampleCount; ++s) {
+    const glm::dvec3 w = sample();
+    const auto h = hitPlane(tri, p, w);
+    if (!h || !(h->t > 0.0)) {
+      ++*offTriangle;
+      observed[binCount] += 1;
+      continue;
+    }
+    if (h->b1 < -1e-6 || h->b2 < -1e-6 || h->b1 + h->b2 > 1.0 + 1e-6) ++*offTriangle;
+    observed[binOf(h->b1, h->b2)] += 1;
+  }
+  const double total = solidAngleOf(tri, p);
+  auto at = [&](int i, int j) {
+    return tri.v0 + (double(i) / k) * (tri.v1 - tri.v0) + (double(j) / k) * (tri.v2 - tri.v0);
+  };
+  double sum = 0.0;
+  for (int i = 0; i < k; ++i)
+    for (int j = 0; i + j < k; ++j) {
+      const double lower = triangleSolidAngle(at(i, j) - p, at(i + 1, j) - p, at(i, j + 1) - p);
+      expected[(i * k + j) * 2] = lower / total * sampleCount;
+      sum += lower;
+      if (i + j <= k - 2) {
+        const double upper = triangleSolidAngle(at(i + 1, j) - p, at(i + 1, j + 1) - p, at(i, j + 1) - p);
+        expected[(i * k + j) * 2 + 1] = upper / total * sampleCount;
+        sum += upper;
+      }
+    }
+  EXPECT_NEAR(sum / total, 1.0, 1e-9) << "the sub-triangles' solid angles do not add up";
+  // Pool bins expecting fewer than 5 into one, as chiSquareSphere does.
+  std::vector<std::pair<double, double>> bins;
+  for (int b = 0; b <= binCount; ++b) bins.push_back({expected[b], observed[b]});
+  std::sort(bins.begin(), bins.end());
+  double chi2 = 0.0, poolE = 0.0, poolO = 0.0;
+  int dof = -1;
+  for (const auto& [e, o] : bins) {
+    if (poolE < 5.0) {
+      poolE += e;
+      poolO += o;
+      continue;
+    }
+    chi2 += (poolO - poolE) * (poolO - poolE) / poolE;
+    ++dof;
+    poolE = e;
+    poolO = o;
+  }
+  if (poolE > 0.0) {
+    chi2 += (poolO - poolE) * (poolO - poolE) / poolE;
+    ++dof;
+  } else if (poolO > 0.0) {
+    chi2 = INFINITY;
+  }
+  test::ChiSquareResult r;
+  r.statistic = chi2;
+  r.degreesOfFreedom = dof;
+  r.pValue = test::chiSquareTail(chi2, dof);
+  r.report = "chi2=" + std::to_string(chi2) + " dof=" + std::to_string(dof);
+  return r;
+}
+
+// The configurations every test below runs through: a triangle in the plane z = 0 seen from
+// several points.
+struct Config {
+  const char* name;
+  Triangle tri;
+  glm::dvec3 p;
+};
+const Triangle kBig{{-1.0, -1.0, 0.0}, {2.0, -0.5, 0.0}, {-0.5, 1.5, 0.0}};
+std::vector<Config> configs() {
+  const double s = 1e-3;  // a small triangle, 1 mm across
+  return {
+      {"large (2.5 sr)", kBig, {0.1, 0.2, 0.8}},
+      {"near a hemisphere (6.2 sr)", kBig, {0.1, 0.2, 0.01}},
+      {"small, close (q = 0.2)", {{0.0, 0.0, 0.0}, {s, 0.0, 0.0}, {0.2 * s, 0.9 * s, 0.0}}, {0.3 * s, 0.3 * s, 5 * s}},
+      {"grazing (2 degrees above the plane)", kBig, {6.0, 0.3, 0.2}},
+      {"grazing (0.01 degrees)", kBig, {6.0, 0.3, 1e-3}},
+      {"far (1000 sizes away)", kBig, {300.0, -500.0, 2000.0}},
+      {"seen from below", kBig, {0.4, -0.3, -0.5}},
+  };
+}
+// Beyond what EmitterSet asks of the sampler (it samples by area below 1e-10 sr and within 1e-6 sr
+// of a hemisphere): the sampler itself still holds there, so those limits have a margin.
+std::vector<Config> extremeConfigs() {
+  const double s = 1e-5;
+  return {
+      {"tiny (4.5e-11 sr)", {{0.0, 0.0, 0.0}, {s, 0.0, 0.0}, {0.2 * s, 0.9 * s, 0.0}}, {0.3 * s, 0.3 * s, 1.0}},
+      {"grazing (1e-7 above the plane, 2e-9 sr)", kBig, {6.0, 0.3, 1e-7}},
+      {"6.5e-7 sr short of a hemisphere", kBig, {0.1, 0.2, 1e-7}},
+      {"1e-8 above, near a vertex", kBig, {-0.99, -0.99, 1e-8}},
+  };
+}
+
+// ---- The spherical triangle --------------------------------------------------------------------
+
+TEST(SphericalTriangle, SolidAngleAnchors) {
+  const glm::dvec3 o(0.0);
+  // An octant: pi / 2.
+  EXPECT_NEAR(triangleSolidAngle({1, 0, 0}, {0, 1, 0}, {0, 0, 1}), kPiD / 2.0, 1e-14);
+  EXPECT_NEAR(triangleSolidAngle({0, 0, 1}, {0, 1, 0}, {1, 0, 0}), kPiD / 2.0, 1e-14);  // either winding
+  // Half a cube face from the cube's centre: 4 pi / 12.
+  EXPECT_NEAR(triangleSolidAngle({-1, -1, 1}, {1, -1, 1}, {1, 1, 1}), kPiD / 3.0, 1e-14);
+  // A face of a regular tetrahedron from its centre: pi.
+  const glm::dvec3 t0(1, 1, 1), t1(1, -1, -1), t2(-1, 1, -1);
+  EXPECT_NEAR(triangleSolidAngle(t0, t1, t2), kPiD, 1e-13);
+  // A tiny triangle facing the point: area / d^2 to second order.
+  const double a = 1e-5, d = 3.0;
+  const double omega = triangleSolidAngle({0, 0, d}, {a, 0, d}, {0, a, d});
+  EXPECT_NEAR(omega / (0.5 * a * a / (d * d)), 1.0, 1e-9);
+  // In the triangle's plane: nothing.
+  EXPECT_EQ(triangleSolidAngle({1, 0, 0}, {2, 0, 0}, {1, 1, 0}), 0.0);
+  EXPECT_EQ(triangleSolidAngle(o, {1, 0, 0}, {0, 1, 0}), 0.0);
+}
+
+TEST(SphericalTriangle, PdfIntegratesToOne) {
+  // The density 1 / solid angle integrated over the directions that hit the triangle: by
+  // quadrature over its area for every configuration, and over the whole sphere of directions for
+  // those large enough for the grid.
+  for (const Config& c : configs()) {
+    const double omega = solidAngleOf(c.tri, c.p);
+    ASSERT_GT(omega, 0.0) << c.name;
+    EXPECT_NEAR(solidAngleByQuadrature(c.tri, c.p, 2000) / omega, 1.0, 1e-4) << c.name << ", omega " << omega;
+    if (omega > 1.0) {
+      auto pdf = [&](const glm::vec3& w) { return hitsTriangle(c.tri, c.p, glm::dvec3(w)) ? 1.0 / omega : 0.0; };
+      EXPECT_NEAR(test::integrateSphere(pdf, 1024, 2048), 1.0, 3e-3) << c.name;
+    }
+  }
+}
+
+TEST(SphericalTriangle, SamplesAreUniformOnTheTriangle) {
+  std::vector<Config> all = configs();
+  for (const Config& c : extremeConfigs()) all.push_back(c);
+  for (const Config& c : all) {
+    const SphericalTriangle st(c.tri.v0 - c.p, c.tri.v1 - c.p, c.tri.v2 - c.p);
+    ASSERT_TRUE(st.valid()) << c.name;
+    ASSERT_NEAR(st.solidAngle(), solidAngleOf(c.tri, c.p), 1e-15 * st.solidAngle()) << c.name;
+    Uniforms u(17);
+    int off = 0;
+    const auto r = chiSquareOnTriangle(c.tri, c.p, [&] { return st.sample(glm::dvec2(u.next2())); }, 200000, 12, &off);
+    EXPECT_GT(r.pValue, kSignificance) << c.name << ": " << r.report;
+    EXPECT_EQ(off, 0) << c.name << ": samples off the triangle";
+  }
+}
+
+TEST(SphericalTriangle, LargeTriangleMatchesPdfOnSphereBins) {
+  // The same check with the suite's sphere histogram, for the two configurations large enough
+  // for its bins.
+  // Near a hemisphere the sub-triangle bins of the test above cannot follow the samples, which
+  // crowd about the foot of the point; sphere bins can.
+  for (const Config& c : {configs()[0], configs()[1], configs()[6], extremeConfigs()[2], extremeConfigs()[3]}) {
+    const SphericalTriangle st(c.tri.v0 - c.p, c.tri.v1 - c.p, c.tri.v2 - c.p);
+    Uniforms u(23);
+    const auto r = test::chiSquareSphere([&] { return glm::vec3(st.sample(glm::dvec2(u.next2()))); },
+                                         [&](const glm::vec3& w) {
+                                           return hitsTriangle(c.tri, c.p, glm::dvec3(w)) ? 1.0 / st.solidAngle() : 0.0;
+                                         },
+                                         300000, 64, 128, 16);
+    EXPECT_GT(r.pValue, kSignificance) << c.name << ": " << r.report;
+  }
+}
+
+TEST(SphericalTriangle, EdgesOfTheSquareMapToEdgesOfTheTriangle) {
+  // u = (0, *) is vertex A's corner sub-triangle of no area: the arc from B to A; u = (1, 1) is C.
+  const Config c = configs()[0];
+  const SphericalTriangle st(c.tri.v0 - c.p, c.tri.v1 - c.p, c.tri.v2 - c.p);
+  const glm::dvec3 A = glm::normalize(c.tri.v0 - c.p), B = glm::normalize(c.tri.v1 - c.p),
+                   C = glm::normalize(c.tri.v2 - c.p);
+  EXPECT_LT(glm::length(st.sample({0.0, 1.0}) - A), 1e-12);
+  EXPECT_LT(glm::length(st.sample({0.7, 0.0}) - B), 1e-12);
+  EXPECT_LT(glm::length(st.sample({1.0, 1.0}) - C), 1e-9);
+}
+
+TEST(SphericalTriangle, BarycentricsOfTheSampledDirection) {
+  const Config c = configs()[0];
+  const glm::dvec3 x = 0.2 * c.tri.v0 + 0.5 * c.tri.v1 + 0.3 * c.tri.v2;
+  const glm::dvec2 b = rayTriangleBarycentrics(c.p, glm::normalize(x - c.p), c.tri.v0, c.tri.v1, c.tri.v2);
+  EXPECT_NEAR(b.x, 0.5, 1e-12);
+  EXPECT_NEAR(b.y, 0.3, 1e-12);
+  // Outside the triangle: clamped onto it.
+  const glm::dvec3 outside = c.tri.v1 + 0.3 * (c.tri.v1 - c.tri.v0);
+  const glm::dvec2 o = rayTriangleBarycentrics(c.p, glm::normalize(outside - c.p), c.tri.v0, c.tri.v1, c.tri.v2);
+  EXPECT_GE(o.x, 0.0);
+  EXPECT_GE(o.y, 0.0);
+  EXPECT_LE(o.x + o.y, 1.0);
+}
+
+// ---- The alias table ---------------------------------------------------------------------------
+
+// Exact selection frequencies: u on a grid fine enough that every bin boundary is resolved to 1e-6.
+std::vector<double> exactFrequencies(const AliasTable& t, int steps) {
+  std::vector<double> f(t.size(), 0.0);
+  for (int i = 0; i < steps; ++i) f[t.sample((float(i) + 0.5f) / float(steps))] += 1.0 / steps;
+  return f;
+}
+
+TEST(AliasTable, FrequenciesMatchWeights) {
+  const std::vector<std::vector<float>> cases = {
+      {1.0f, 2.0f, 3.0f, 4.0f},
+      {0.0f, 3.0f, 0.0f, 1.0f, 5.0f, 0.5f, 0.0f},  // zero weights, never returned
+      {7.0f},                                       // one weight
+      {0.0f, 0.0f, 4.0f, 0.0f},                     // one non-zero weight among zeros
+      {1e-6f, 1.0f, 1e6f, -2.0f, NAN, INFINITY},    // 12 decades; invalid weights count as 0
+  };
+  for (const auto& w : cases) {
+    const AliasTable table(w);
+    ASSERT_FALSE(table.empty());
+    double total = 0.0;
+    for (float x : w) total += std::isfinite(x) && x > 0.0f ? double(x) : 0.0;
+    const std::vector<double> f = exactFrequencies(table, 1 << 22);
+    Uniforms u(5);
+    std::vector<double> counts(w.size(), 0.0);
+    const int n = 200000;
+    for (int s = 0; s < n; ++s) {
+      float pmf = -1.0f;
+      const size_t i = table.sample(u.next(), &pmf);
+      ASSERT_LT(i, w.size());
+      ASSERT_GT(w[i], 0.0f) << "a zero weight was returned";
+      ASSERT_EQ(pmf, table.pmf(i));
+      counts[i] += 1;
+    }
+    double chi2 = 0.0;
+    int dof = -1;
+    for (size_t i = 0; i < w.size(); ++i) {
+      const double p = std::isfinite(w[i]) && w[i] > 0.0f ? double(w[i]) / total : 0.0;
+      EXPECT_NEAR(table.pmf(i), p, 1e-7 * std::max(p, 1e-30) + 1e-12) << "entry " << i;
+      EXPECT_NEAR(f[i], p, 2e-6) << "entry " << i << ": exact frequency";
+      if (p * n >= 5.0) {
+        chi2 += (counts[i] - p * n) * (counts[i] - p * n) / (p * n);
+        ++dof;
+      }
+    }
+    if (dof > 0) EXPECT_GT(test::chiSquareTail(chi2, dof), kSignificance) << "chi2 " << chi2;
+  }
+}
+
+TEST(AliasTable, ManyWeightsAndTheRemappedUniform) {
+  // 1000 entries with a heavy tail and a few zeros; the remapped u, given the entry, is uniform.
+  std::vector<float> w(1000);
+  std::mt19937 engine(3);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  for (size_t i = 0; i < w.size(); ++i) w[i] = i % 97 == 0 ? 0.0f : std::pow(unit(engine), 4.0f) * 100.0f;
+  const AliasTable table(w);
+  double total = 0.0;
+  for (float x : w) total += x;
+  const std::vector<double> f = exactFrequencies(table, 1 << 24);
+  for (size_t i = 0; i < w.size(); ++i) EXPECT_NEAR(f[i], double(w[i]) / total, 2e-6) << "entry " << i;
+
+  Uniforms u(8);
+  const int bins = 20, n = 400000;
+  std::vector<double> remapped(bins, 0.0);
+  for (int s = 0; s < n; ++s) {
+    float r = -1.0f;
+    table.sample(u.next(), nullptr, &r);
+    ASSERT_GE(r, 0.0f);
+    ASSERT_LT(r, 1.0f);
+    remapped[size_t(std::min(bins - 1, int(r * bins)))] += 1;
+  }
+  double chi2 = 0.0;
+  for (double c : remapped) chi2 += (c - double(n) / bins) * (c - double(n) / bins) / (double(n) / bins);
+  EXPECT_GT(test::chiSquareTail(chi2, bins - 1), kSignificance) << "remapped u, chi2 " << chi2;
+}
+
+TEST(AliasTable, EmptyAndAllZero) {
+  EXPECT_TRUE(AliasTable().empty());
+  const std::vector<float> zeros = {0.0f, 0.0f, -1.0f};
+  EXPECT_TRUE(AliasTable(zeros).empty());
+}
+
+}  // namespace
+}  // namespace vpl
