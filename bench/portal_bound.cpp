@@ -36,7 +36,7 @@ class RectangleContinuation final : public ContinuationSampler {
   bool sample(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, VertexSamples& samples, DirectionSample& out,
               PathStats& stats) override {
     if (!faces(hit) || samples.strategy() < 0.5f) {
-      const auto s = bsdf.sample(wo, samples.bsdfDirection(), samples.bsdfLobe());
+      const auto s = bsdf.sample(wo, samples.bsdfDirection());
       if (!s) return false;
       out.wi = s->wi;
     } else {

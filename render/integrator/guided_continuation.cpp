@@ -43,7 +43,7 @@ bool GuidedContinuation::sample(const SurfaceHit& hit, const Bsdf& bsdf, const g
   const float pBsdf = c < 0 ? 1.0f : bsdfProbability();
   // Only a real choice draws a number: the strategy dimension stays unused where one strategy is certain.
   if (pBsdf >= 1.0f || (pBsdf > 0.0f && u.strategy() < pBsdf)) {
-    const auto s = bsdf.sample(wo, u.bsdfDirection(), u.bsdfLobe());
+    const auto s = bsdf.sample(wo, u.bsdfDirection());
     if (!s) return false;
     out.wi = s->wi;
     ++stats.bsdfSamples;

@@ -14,7 +14,7 @@ std::string PathTracerSettings::validate() const {
 
 bool BsdfContinuation::sample(const SurfaceHit&, const Bsdf& bsdf, const glm::vec3& wo, VertexSamples& u,
                               DirectionSample& out, PathStats& stats) {
-  const auto s = bsdf.sample(wo, u.bsdfDirection(), u.bsdfLobe());
+  const auto s = bsdf.sample(wo, u.bsdfDirection());
   if (!s || !(s->pdf > 0.0f)) return false;
   ++stats.bsdfSamples;
   out.wi = s->wi;

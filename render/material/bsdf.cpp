@@ -98,9 +98,21 @@ float Bsdf::pdf(const glm::vec3& wo, const glm::vec3& wi) const {
 std::optional<BsdfSample> Bsdf::sample(const glm::vec3& woWorld, glm::vec2 u, float uLobe) const {
   const glm::vec3 wo = frame_.toLocal(woWorld);
   if (wo.z <= 0.0f) return std::nullopt;
+  return sampleLobe(wo, u, uLobe < specularProbability(wo.z));
+}
+
+std::optional<BsdfSample> Bsdf::sample(const glm::vec3& woWorld, glm::vec2 u) const {
+  const glm::vec3 wo = frame_.toLocal(woWorld);
+  if (wo.z <= 0.0f) return std::nullopt;
   const float pSpec = specularProbability(wo.z);
+  const bool specular = u.x < pSpec;  // never true when pSpec is 0, always when it is 1
+  u.x = std::min(specular ? u.x / pSpec : (u.x - pSpec) / (1.0f - pSpec), 0x1.fffffep-1f);
+  return sampleLobe(wo, u, specular);
+}
+
+std::optional<BsdfSample> Bsdf::sampleLobe(const glm::vec3& wo, glm::vec2 u, bool specular) const {
   glm::vec3 wi;
-  if (uLobe < pSpec) {
+  if (specular) {
     const glm::vec3 h = ggx::sampleVisibleNormal(wo, u, params_.alpha);
     wi = 2.0f * glm::dot(wo, h) * h - wo;
   } else {

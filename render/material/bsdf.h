@@ -37,6 +37,9 @@ class Bsdf {
   float pdf(const glm::vec3& wo, const glm::vec3& wi) const;
   // Picks a lobe with uLobe, then samples it (GGX: visible normals, Heitz 2018). Empty if no direction.
   std::optional<BsdfSample> sample(const glm::vec3& wo, glm::vec2 u, float uLobe) const;
+  // The same from one 2D number: u.x picks the lobe and, rescaled within that lobe's share, serves
+  // the direction too, so a stratified u stays stratified within each lobe (and costs one number less).
+  std::optional<BsdfSample> sample(const glm::vec3& wo, glm::vec2 u) const;
 
   const BsdfParams& params() const { return params_; }
   const Frame& frame() const { return frame_; }
@@ -53,6 +56,7 @@ class Bsdf {
   glm::vec3 specularAlbedo(float mu) const;
   bool hasSpecular() const { return params_.f90 > 0.0f || params_.f0.x > 0.0f || params_.f0.y > 0.0f || params_.f0.z > 0.0f; }
   float specularProbability(float cosO) const;
+  std::optional<BsdfSample> sampleLobe(const glm::vec3& woLocal, glm::vec2 u, bool specular) const;
   glm::vec3 evalLocal(const glm::vec3& wo, const glm::vec3& wi) const;
   float pdfLocal(const glm::vec3& wo, const glm::vec3& wi) const;
 };

@@ -2,9 +2,10 @@
 //
 // A sample is (seed, pixel, index), the index counting the pixel's samples from 0 and never
 // restarting, so the image depends on nothing else (not threads, not tile order). Each decision
-// has a fixed slot: one Sobol' 1D or 2D stream of sobol.h, shuffled and Owen-scrambled by a hash of
-// (seed, pixel, slot). The first 2^m samples of any slot in a pixel are stratified (one per
-// elementary interval), different slots and pixels are independent of each other.
+// has a fixed slot: one 2D (or 1D) stream of sobol.h, shuffled and Owen-scrambled by a hash of
+// (seed, pixel, slot). The first 2^m samples of any slot in a pixel are stratified (a (0,m,2)-net),
+// different slots and pixels are independent of each other. A slot costs about the same in 1D and
+// 2D, so two 1D decisions of a vertex share one 2D slot, jointly stratified.
 //
 // Slot layout: the camera jitter, the preview's cluster choice, then per path vertex (its depth:
 // 0 is the camera ray's hit) a block of VertexDimension. Past kTabulatedVertices, and for consumers
@@ -19,16 +20,13 @@
 
 namespace vpl {
 
-// The decisions at one path vertex. The 2D ones take one slot each, like the 1D ones.
+// The slots of one path vertex, all 2D.
 enum class VertexDimension : uint32_t {
-  LightChoice,     // 1D: which emitter (next-event estimation)
-  LightPoint,      // 2D: the point on it
-  BsdfLobe,        // 1D: diffuse or specular lobe
-  BsdfDirection,   // 2D: the direction within the lobe
-  Strategy,        // 1D: BSDF or guide (one-sample MIS)
-  GuideCell,       // 1D: the guide's cell (or its defensive uniform share)
-  GuidePoint,      // 2D: the point within that cell
-  Roulette,        // 1D: Russian roulette
+  LightPoint,           // the point on the chosen emitter (next-event estimation)
+  BsdfDirection,        // the BSDF's direction; x also picks its lobe (Bsdf::sample(wo, u))
+  LightChoiceRoulette,  // x: which emitter; y: Russian roulette
+  StrategyGuideCell,    // x: BSDF or guide (one-sample MIS); y: the guide's cell or its defensive share
+  GuidePoint,           // the point within the guide's cell
   Count
 };
 
@@ -47,6 +45,7 @@ class PixelSampler {
   glm::vec2 cameraJitter() { return get2D(kCameraSlot); }
   float previewClusters() { return get1D(kPreviewClusterSlot); }
 
+  // A slot read in 1D is the first coordinate of its 2D point.
   float get1D(int vertex, VertexDimension d) {
     const uint32_t slot = slotOf(vertex, d);
     return vertex < kTabulatedVertices || independent_ ? get1D(slot) : hashedUniform(slot, 0);
@@ -93,20 +92,20 @@ class PixelSampler {
   Rng* independent_ = nullptr;
 };
 
-// The numbers of one path vertex: handed to whoever decides something there.
+// The numbers of one path vertex: handed to whoever decides something there. A slot shared by two
+// decisions is drawn once, when the first of them asks.
 class VertexSamples {
  public:
   VertexSamples(PixelSampler& sampler, int vertex) : sampler_(sampler), vertex_(vertex) {}
 
   int vertex() const { return vertex_; }
-  float lightChoice() { return sampler_.get1D(vertex_, VertexDimension::LightChoice); }
   glm::vec2 lightPoint() { return sampler_.get2D(vertex_, VertexDimension::LightPoint); }
-  float bsdfLobe() { return sampler_.get1D(vertex_, VertexDimension::BsdfLobe); }
   glm::vec2 bsdfDirection() { return sampler_.get2D(vertex_, VertexDimension::BsdfDirection); }
-  float strategy() { return sampler_.get1D(vertex_, VertexDimension::Strategy); }
-  float guideCell() { return sampler_.get1D(vertex_, VertexDimension::GuideCell); }
+  float lightChoice() { return pair(lightChoiceRoulette_, VertexDimension::LightChoiceRoulette).x; }
+  float roulette() { return pair(lightChoiceRoulette_, VertexDimension::LightChoiceRoulette).y; }
+  float strategy() { return pair(strategyGuideCell_, VertexDimension::StrategyGuideCell).x; }
+  float guideCell() { return pair(strategyGuideCell_, VertexDimension::StrategyGuideCell).y; }
   glm::vec2 guidePoint() { return sampler_.get2D(vertex_, VertexDimension::GuidePoint); }
-  float roulette() { return sampler_.get1D(vertex_, VertexDimension::Roulette); }
   // The vertex's own random stream (Metropolis chains), made on first use.
   Rng& random() {
     if (!random_) random_ = sampler_.random(vertex_);
@@ -114,8 +113,14 @@ class VertexSamples {
   }
 
  private:
+  glm::vec2 pair(std::optional<glm::vec2>& cached, VertexDimension d) {
+    if (!cached) cached = sampler_.get2D(vertex_, d);
+    return *cached;
+  }
+
   PixelSampler& sampler_;
   int vertex_;
+  std::optional<glm::vec2> lightChoiceRoulette_, strategyGuideCell_;
   std::optional<Rng> random_;
 };
 

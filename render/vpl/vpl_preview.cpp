@@ -70,7 +70,7 @@ glm::vec3 reflectedLight(const RenderScene& scene, SurfaceHit surface, Bsdf bsdf
   glm::vec3 L(0.0f), beta(1.0f);
   for (int bounce = 0; bounce < kSpecularBounces; ++bounce) {
     VertexSamples u(sampler, bounce);
-    const auto next = bsdf.sample(wo, u.bsdfDirection(), u.bsdfLobe());
+    const auto next = bsdf.sample(wo, u.bsdfDirection());
     if (!next || glm::dot(next->wi, surface.geometricNormal) <= 0.0f) break;
     beta *= next->weight;
     const Ray ray = spawnRay(surface, next->wi);

@@ -10,7 +10,9 @@
 #include <set>
 #include <string>
 #include <vector>
+#include "render/core/frame.h"
 #include "render/film/film.h"
+#include "render/material/bsdf.h"
 #include "render/sampling/pixel_sampler.h"
 #include "render/sampling/rng.h"
 #include "render/sampling/sobol.h"
@@ -95,8 +97,10 @@ struct Slot2 {
   int vertex;
   VertexDimension d;
 };
-constexpr Slot1 kSlots1D[] = {{0, VertexDimension::LightChoice}, {0, VertexDimension::BsdfLobe}, {2, VertexDimension::Strategy},
-                              {5, VertexDimension::Roulette}, {7, VertexDimension::GuideCell}};
+// A slot read in 1D is its first coordinate: the lists share no slot.
+constexpr Slot1 kSlots1D[] = {{0, VertexDimension::LightChoiceRoulette}, {1, VertexDimension::StrategyGuideCell},
+                              {2, VertexDimension::LightPoint}, {5, VertexDimension::LightChoiceRoulette},
+                              {7, VertexDimension::GuidePoint}};
 constexpr Slot2 kSlots2D[] = {{0, VertexDimension::LightPoint}, {0, VertexDimension::BsdfDirection},
                               {3, VertexDimension::GuidePoint}, {7, VertexDimension::BsdfDirection}};
 
@@ -353,9 +357,9 @@ TEST(PixelSampler, StratifiedEstimatesBeatIndependentOnes) {
       PixelSampler independent(rng);
       s2 += f2(sampler.get2D(1, VertexDimension::BsdfDirection));
       s2r += f2(independent.get2D(1, VertexDimension::BsdfDirection));
-      s1 += f1(sampler.get1D(1, VertexDimension::BsdfLobe), sampler.get1D(1, VertexDimension::Roulette));
-      const float a = independent.get1D(1, VertexDimension::BsdfLobe);
-      s1r += f1(a, independent.get1D(1, VertexDimension::Roulette));
+      s1 += f1(sampler.get1D(1, VertexDimension::LightChoiceRoulette), sampler.get1D(1, VertexDimension::StrategyGuideCell));
+      const float a = independent.get1D(1, VertexDimension::LightChoiceRoulette);
+      s1r += f1(a, independent.get1D(1, VertexDimension::StrategyGuideCell));
     }
     se2 += std::pow(s2 / kN - exact2, 2);
     se2Random += std::pow(s2r / kN - exact2, 2);
@@ -369,15 +373,21 @@ TEST(PixelSampler, StratifiedEstimatesBeatIndependentOnes) {
 
 TEST(PixelSampler, DeterministicInSeedPixelIndexAndIndependentOfCallOrder) {
   PixelSampler a(4, 77, 12), b(4, 77, 12);
-  const float lobe = a.get1D(2, VertexDimension::BsdfLobe);
+  const float strategy = a.get1D(2, VertexDimension::StrategyGuideCell);
   const glm::vec2 light = a.get2D(0, VertexDimension::LightPoint);
   const glm::vec2 jitter = a.cameraJitter();
   // b asks in another order, and asks for other slots in between.
   EXPECT_EQ(b.cameraJitter(), jitter);
-  b.get1D(0, VertexDimension::Roulette);
+  b.get1D(0, VertexDimension::LightChoiceRoulette);
   EXPECT_EQ(b.get2D(0, VertexDimension::LightPoint), light);
-  EXPECT_EQ(b.get1D(2, VertexDimension::BsdfLobe), lobe);
-  EXPECT_EQ(a.get1D(2, VertexDimension::BsdfLobe), lobe);  // asking twice gives the same number
+  EXPECT_EQ(b.get1D(2, VertexDimension::StrategyGuideCell), strategy);
+  EXPECT_EQ(a.get1D(2, VertexDimension::StrategyGuideCell), strategy);  // asking twice gives the same number
+  // A vertex's paired decisions are the two coordinates of one slot, whichever is asked first.
+  VertexSamples v(a, 2);
+  EXPECT_EQ(v.guideCell(), a.get2D(2, VertexDimension::StrategyGuideCell).y);
+  EXPECT_EQ(v.strategy(), strategy);
+  EXPECT_EQ(VertexSamples(b, 3).roulette(), a.get2D(3, VertexDimension::LightChoiceRoulette).y);
+  EXPECT_EQ(VertexSamples(b, 3).lightChoice(), a.get2D(3, VertexDimension::LightChoiceRoulette).x);
   EXPECT_NE(PixelSampler(5, 77, 12).cameraJitter(), jitter);
   EXPECT_NE(PixelSampler(4, 78, 12).cameraJitter(), jitter);
   EXPECT_NE(PixelSampler(4, 77, 13).cameraJitter(), jitter);
@@ -385,7 +395,7 @@ TEST(PixelSampler, DeterministicInSeedPixelIndexAndIndependentOfCallOrder) {
   // Independent mode is the given stream, in the order asked.
   Rng r1(8), r2(8);
   PixelSampler independent(r1);
-  EXPECT_EQ(independent.get1D(0, VertexDimension::Roulette), r2.uniform());
+  EXPECT_EQ(independent.get1D(0, VertexDimension::LightChoiceRoulette), r2.uniform());
   EXPECT_EQ(independent.cameraJitter(), r2.uniform2());
 }
 
@@ -398,12 +408,12 @@ TEST(PixelSampler, DeepVerticesAndStreamsAreUniformAndDeterministic) {
   std::vector<glm::vec2> dirs;
   for (int k = 0; k < kN; ++k) {
     PixelSampler s(2, 10, uint64_t(k));
-    a.push_back(s.get1D(deep, VertexDimension::Roulette));
-    b.push_back(s.get1D(deep + 1, VertexDimension::Roulette));
+    a.push_back(s.get1D(deep, VertexDimension::LightChoiceRoulette));
+    b.push_back(s.get1D(deep + 1, VertexDimension::LightChoiceRoulette));
     dirs.push_back(s.get2D(deep + 20, VertexDimension::BsdfDirection));
     streamA.push_back(s.random(0).uniform());
     streamB.push_back(s.random(1).uniform());
-    ASSERT_EQ(PixelSampler(2, 10, uint64_t(k)).get1D(deep, VertexDimension::Roulette), a.back());
+    ASSERT_EQ(PixelSampler(2, 10, uint64_t(k)).get1D(deep, VertexDimension::LightChoiceRoulette), a.back());
     ASSERT_EQ(PixelSampler(2, 10, uint64_t(k)).random(0).uniform(), streamA.back());
   }
   const double bound = 4.0 / std::sqrt(double(kN));
@@ -416,6 +426,37 @@ TEST(PixelSampler, DeepVerticesAndStreamsAreUniformAndDeterministic) {
   std::vector<float> dx, dy;
   for (const glm::vec2& d : dirs) dx.push_back(d.x), dy.push_back(d.y);
   EXPECT_LT(std::abs(correlation(dx, dy)), bound);
+}
+
+// Bsdf::sample(wo, u) picks the lobe with u.x and reuses it, rescaled, for the direction: the
+// directions must have the BSDF's pdf (chi-square), as the three-number form's do in test_bsdf.
+TEST(PixelSampler, BsdfFromOneTwoDNumberMatchesItsPdf) {
+  struct Case {
+    const char* name;
+    glm::vec3 diffuse, f0;
+    float f90, alpha;
+  };
+  for (const Case& c : {Case{"dielectric", glm::vec3(0.7f, 0.5f, 0.3f), glm::vec3(0.04f), 1.0f, 0.2f},
+                        Case{"metal", glm::vec3(0.0f), glm::vec3(0.9f, 0.6f, 0.5f), 1.0f, 0.5f},
+                        Case{"diffuse", glm::vec3(0.8f), glm::vec3(0.0f), 0.0f, 1.0f}})
+    for (float cosO : {0.9f, 0.3f}) {
+      BsdfParams params;
+      params.diffuse = c.diffuse;
+      params.f0 = c.f0;
+      params.f90 = c.f90;
+      params.alpha = c.alpha;
+      const Bsdf bsdf(params, Frame::fromNormal(glm::normalize(glm::vec3(0.2f, 0.3f, 0.9f))));
+      const float sinO = std::sqrt(1.0f - cosO * cosO);
+      const glm::vec3 wo = bsdf.frame().toWorld(glm::vec3(sinO * std::cos(0.7f), sinO * std::sin(0.7f), cosO));
+      Rng rng(17);
+      auto sample = [&]() -> glm::vec3 {
+        const auto s = bsdf.sample(wo, rng.uniform2());
+        return s ? bsdf.frame().toLocal(s->wi) : glm::vec3(0.0f);
+      };
+      auto pdf = [&](const glm::vec3& wLocal) { return double(bsdf.pdf(wo, bsdf.frame().toWorld(wLocal))); };
+      const auto r = test::chiSquareSphere(sample, pdf, 200000, 48, 96, 8);
+      EXPECT_GT(r.pValue, kSignificance) << c.name << " cosO " << cosO << ": " << r.report;
+    }
 }
 
 // Streams made from neighbouring keys are unrelated, number by number.
