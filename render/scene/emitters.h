@@ -1,11 +1,16 @@
-// Every light of a scene in one power-weighted distribution: emissive triangles, KHR punctual
-// lights and the uniform sky. Next-event estimation samples it; emitter hits ask it for the pdf.
+// Every light of a scene in one power-weighted distribution (an alias table: O(1) per choice):
+// emissive triangles, KHR punctual lights and the uniform sky. Next-event estimation samples it;
+// emitter hits ask it for the pdf. A triangle is sampled uniformly in the solid angle it subtends
+// when it looks large from the reference point and by area when it looks small (see
+// solidAngleStrategy in emitters.cpp); the choice depends on the point and the triangle only, so
+// pdfTriangle returns the density of the strategy sample() used.
 #pragma once
 #include <cstdint>
 #include <optional>
 #include <vector>
 #include <glm/glm.hpp>
-#include "render/sampling/distribution_1d.h"
+#include "render/sampling/alias_table.h"
+#include "render/sampling/spherical_triangle.h"
 #include "render/scene/scene_data.h"
 #include "render/scene/surface.h"
 
@@ -40,6 +45,9 @@ class EmitterSet {
   std::optional<LightSample> sample(const glm::vec3& p, float uLight, glm::vec2 u) const;
   // Density (solid angle, at p) with which sample() picks the emitting triangle point x of a hit.
   float pdfTriangle(const glm::vec3& p, const SurfaceHit& hit) const;
+  // Whether sample() draws the emitting triangle (mesh, triangle) by solid angle from p (else by
+  // area); false for a triangle that does not emit.
+  bool sampledBySolidAngle(const glm::vec3& p, uint32_t mesh, uint32_t triangle) const;
   // Density with which sample() picks direction wi towards the sky.
   float pdfSky(const glm::vec3& wi) const;
 
@@ -56,13 +64,20 @@ class EmitterSet {
     uint32_t mesh, triangle;
     float area;
     bool twoSided;
+    glm::vec3 p0, p1, p2;  // vertices
+    glm::vec3 normal;      // unit, from the winding (the front side)
+    glm::vec3 centre;      // of the bounding sphere (the centroid) ...
+    float radius;          // ... and its radius (the farthest vertex)
+    float longestEdge;     // the triangle's diameter
+    float coordinateScale; // largest |coordinate| of the vertices
+    bool textured;         // the emission has a texture (radiance varies over the triangle)
   };
   const SceneData* scene_ = nullptr;
   std::vector<TriangleLight> triangles_;
   std::vector<PunctualLight> punctual_;
   // For each mesh, the emitter index of each triangle (empty for non-emissive meshes).
   std::vector<std::vector<int32_t>> triangleIndex_;
-  Distribution1D distribution_;  // over [triangles..., punctual..., sky]
+  AliasTable distribution_;  // over [triangles..., punctual..., sky]
   int skyIndex_ = -1;
   glm::vec3 sky_{0.0f};
   glm::vec3 centre_{0.0f};
@@ -73,6 +88,12 @@ class EmitterSet {
     glm::vec3 position, normal;  // normal from the winding (the front side)
   };
   TrianglePoint trianglePoint(const TriangleLight& light, glm::vec2 barycentric) const;
+  // The spherical triangle of `light` seen from p when sample() samples it by solid angle from
+  // there; nullopt when it samples by area.
+  static std::optional<SphericalTriangle> solidAngleStrategy(const glm::vec3& p, const TriangleLight& light);
+  // Signed distance from p to the triangle's plane (positive on the front side), or NaN when p lies
+  // in that plane as far as the renderer can tell: no light from the triangle reaches p then.
+  static float planeDistance(const glm::vec3& p, const TriangleLight& light);
 };
 
 }  // namespace vpl
