@@ -234,9 +234,9 @@ int runViewer(const ViewerOptions& options) {
       }
       ImGui::Render();
 
+      const bool shoot = fbWidth > 0 && fbHeight > 0 && !options.screenshot.empty() && secondsSince(opened) >= options.screenshotAfter;
       if (fbWidth > 0 && fbHeight > 0) {
         display.draw(fbWidth, fbHeight, exposure, DisplayView(view));
-        const bool shoot = !options.screenshot.empty() && secondsSince(opened) >= options.screenshotAfter;
         // What the window shows: read before the panel is drawn over it, unless it is wanted.
         if (shoot && !options.screenshotPanel) writePngBytes(options.screenshot, fbWidth, fbHeight, display.readPixels(fbWidth, fbHeight));
         ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
@@ -245,7 +245,8 @@ int runViewer(const ViewerOptions& options) {
       }
       glfwSwapBuffers(window);
       ++framesSinceLog;
-      if (log && secondsSince(lastLog) >= 1.0) {
+      // The screenshot's frame is always logged: a script can tell which stage it shows.
+      if (log && (secondsSince(lastLog) >= 1.0 || shoot)) {
         std::fprintf(log, "t %.2f fps %.1f stage %s spp %d first_frame_ms %.1f samples_per_s %.4g\n", secondsSince(opened),
                      framesSinceLog / secondsSince(lastLog), stageName(stats.stage), stats.spp,
                      1e3 * stats.firstFrameSeconds, stats.samplesPerSecond);
