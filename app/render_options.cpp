@@ -60,6 +60,10 @@ void RenderOptions::addCommonTo(CLI::App& command) {
   command.add_option("--threads", threads, "worker threads (0: all cores)")->check(CLI::Range(0, 1024));
   command.add_option("--max-depth", maxDepth, "maximum path length in segments (1: direct light only)")
       ->check(CLI::Range(1, 1024));
+  command.add_option("--rr-start", rrStart, "first path depth at which Russian roulette may end a path")
+      ->check(CLI::Range(1, 1024));
+  command.add_option("--roulette", roulette, "Russian roulette survival: throughput (min(1, max beta)) | sqrt (its square root)")
+      ->check(CLI::IsMember({"throughput", "sqrt"}));
   command.add_option("--sky", sky, "uniform sky radiance R,G,B; 0 turns it off (default: on only without lights)");
   command.add_option("--exposure", exposure, "PNG exposure in stops");
   command.add_option("--vpls", preview.vpl.count, "number of VPLs")->check(CLI::Range(0, 50'000'000));
@@ -99,6 +103,8 @@ RenderJobSettings RenderOptions::toSettings() const {
   s.spp = spp > 0 ? spp : 16;
   s.timeBudget = time;
   s.tracer.maxDepth = maxDepth;
+  s.tracer.rrStartDepth = rrStart;
+  s.tracer.roulette = roulette == "sqrt" ? RouletteRule::Sqrt : RouletteRule::Throughput;
   s.preview = preview;
   s.guide = guide;
   s.guide.coneAngle = coneDegrees * 3.14159265f / 180.0f;

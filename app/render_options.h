@@ -15,6 +15,8 @@ struct RenderOptions {
   uint64_t seed = 1;
   int threads = 0;  // 0 = all cores
   int maxDepth = 32;
+  int rrStart = PathTracerSettings{}.rrStartDepth;
+  std::string roulette = "sqrt";
   std::string out, png;
   std::string sky;  // "R,G,B", "0", or empty (automatic)
   float exposure = 0.0f;

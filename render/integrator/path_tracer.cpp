@@ -83,7 +83,8 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
 
     // Russian roulette on the throughput (after a few bounces, so short paths keep full weight).
     if (depth + 1 >= settings_.rrStartDepth) {
-      const float survive = std::min(1.0f, maxComponent(beta));
+      const float t = maxComponent(beta);
+      const float survive = std::min(1.0f, settings_.roulette == RouletteRule::Sqrt ? std::sqrt(t) : t);
       if (u.roulette() >= survive) break;
       beta /= survive;
     }

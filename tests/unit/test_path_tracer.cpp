@@ -1,6 +1,8 @@
 // The reference path tracer (`brdf`) against analytic answers, and its determinism. Its agreement with
 // an independent renderer on whole scenes is test_cycles_anchor.
 #include <cmath>
+#include <string>
+#include <tuple>
 #include <tbb/global_control.h>
 #include "render/film/film.h"
 #include "render/integrator/path_tracer.h"
@@ -18,10 +20,13 @@ struct Rendered {
   PassStats stats;
 };
 
-Rendered renderScene(const RenderScene& scene, int width, int height, int spp, uint64_t seed, int maxDepth = 64) {
+Rendered renderScene(const RenderScene& scene, int width, int height, int spp, uint64_t seed, int maxDepth = 64,
+                     RouletteRule roulette = PathTracerSettings{}.roulette, int rrStart = PathTracerSettings{}.rrStartDepth) {
   const Camera camera(defaultCamera(scene.data()), width, height);
   PathTracerSettings settings;
   settings.maxDepth = maxDepth;
+  settings.roulette = roulette;
+  settings.rrStartDepth = rrStart;
   const PathTracer tracer(scene, settings);
   const TileRenderer renderer(camera, seed, pathTracerShader(tracer));
   Film film(width, height);
@@ -46,12 +51,14 @@ MeanAndError channelMean(const Image& image, int channel) {
   return {mean, std::sqrt(std::max(0.0, sum2 / n - mean * mean) / n)};
 }
 
-class WhiteFurnace : public ::testing::TestWithParam<float> {};
+// Albedo, Russian roulette rule and the depth it starts at: every rule must keep the estimate unbiased.
+class WhiteFurnace : public ::testing::TestWithParam<std::tuple<float, RouletteRule, int>> {};
 
 TEST_P(WhiteFurnace, ConvergesToAnalyticRadiance) {
-  const float rho = GetParam(), le = 0.5f;
+  const auto [rho, roulette, rrStart] = GetParam();
+  const float le = 0.5f;
   const RenderScene scene(test::furnaceScene(rho, le));
-  const Rendered r = renderScene(scene, 32, 32, 64, 11, 1024);
+  const Rendered r = renderScene(scene, 32, 32, 64, 11, 1024, roulette, rrStart);
   const double expected = le / (1.0 - rho);
   for (int c = 0; c < 3; ++c) {
     const MeanAndError m = channelMean(r.image, c);
@@ -60,7 +67,17 @@ TEST_P(WhiteFurnace, ConvergesToAnalyticRadiance) {
   EXPECT_EQ(r.stats.discarded, 0u);
 }
 
-INSTANTIATE_TEST_SUITE_P(Albedos, WhiteFurnace, ::testing::Values(0.0f, 0.5f, 0.8f));
+std::string furnaceName(const ::testing::TestParamInfo<WhiteFurnace::ParamType>& info) {
+  const float rho = std::get<0>(info.param);
+  return "albedo" + std::to_string(int(rho * 10)) + (std::get<1>(info.param) == RouletteRule::Sqrt ? "_sqrt" : "_throughput") +
+         "_from" + std::to_string(std::get<2>(info.param));
+}
+
+INSTANTIATE_TEST_SUITE_P(AlbedosAndRoulette, WhiteFurnace,
+                         ::testing::Combine(::testing::Values(0.0f, 0.5f, 0.8f),
+                                            ::testing::Values(RouletteRule::Throughput, RouletteRule::Sqrt),
+                                            ::testing::Values(1, 5)),
+                         furnaceName);
 
 TEST(WhiteFurnace, GlossyMetalNeverGainsEnergy) {
   // A perfect-white rough metal reflects at most what it receives: radiance <= le / (1 - 1) is
