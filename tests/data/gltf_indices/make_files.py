@@ -4,6 +4,8 @@ index glTF 2.0 has (scene, nodes, mesh, camera, children, skin, light, primitive
 morph target, material, every textureInfo, texture source and sampler, image bufferView, accessor and
 sparse bufferViews, bufferView buffer, animation), is clean under the Khronos glTF-Validator; each
 bad_*.gltf breaks one index of it. no_triangles.gltf is valid and instances nothing.
+float_index.gltf writes mesh index 0 as 0.0: the JavaScript validator accepts it, vplview does not
+(README.md, "Where vplview and the glTF validator disagree").
 Usage: tests/data/gltf_indices/make_files.py [OUT_DIR]"""
 import copy, json, os, struct, sys
 
@@ -147,5 +149,6 @@ for name, path, value in BROKEN:
 doc = broken(["nodes", 1, "mesh"], -5)
 del doc["buffers"][0]["uri"]
 write("bad_node_mesh.glb", glb(doc, binary))
+write("float_index.gltf", broken(["nodes", 1, "mesh"], 0.0))
 write("no_triangles.gltf", {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
                             "nodes": [{"camera": 0}], "cameras": valid["cameras"]})
