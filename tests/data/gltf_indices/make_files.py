@@ -130,7 +130,7 @@ BROKEN = [
 
 def write(name, content):
     with open(os.path.join(out, name), "wb") as f:
-        f.write(content if isinstance(content, bytes) else (json.dumps(content, indent=1) + "\n").encode())
+        f.write(content if isinstance(content, bytes) else (json.dumps(content, separators=(",", ":")) + "\n").encode())
 
 
 def broken(path, value):
