@@ -2,10 +2,10 @@
 
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
+#include <sstream>
 #include <unistd.h>
 #include <tbb/global_control.h>
-#include "render/core/error.h"
+#include "render/film/atomic_file.h"
 #include "render/film/image_io.h"
 #include "render/film/plot.h"
 #include "app/list_options.h"
@@ -30,7 +30,7 @@ int runConverge(const ConvergeOptions& converge, const RenderOptions& render, co
   const std::string &csvPath = paths[0], &plotPath = paths[1];
   tbb::global_control threads(tbb::global_control::max_allowed_parallelism, render.threadCount());
 
-  std::ofstream csv(csvPath);
+  std::ostringstream csv;  // written whole at the end (atomic_file.h): no half-written table
   csv << "mode,budget,seconds,spp,relmse,bias\n";
   std::vector<PlotSeries> series;
   const bool terminal = isatty(STDERR_FILENO) != 0;
@@ -49,8 +49,7 @@ int runConverge(const ConvergeOptions& converge, const RenderOptions& render, co
     }
     series.push_back(std::move(line));
   }
-  csv.close();
-  if (!csv) throw InputError(csvPath + ": cannot write");
+  writeFileAtomically(csvPath, csv.str());
   const std::string title = "relMSE against time: " + std::filesystem::path(settings.scenePath).filename().string() + ", " +
                             std::to_string(settings.width) + "x" + std::to_string(settings.height);
   const PlotPixels plot = plotLogLog(series, title, "seconds (preprocessing included)", "relMSE");

@@ -1,12 +1,13 @@
 #include "app/sweep.h"
 
 #include <cstdio>
-#include <fstream>
+#include <sstream>
 #include <unistd.h>
 #include <tbb/global_control.h>
 #include "app/list_options.h"
 #include "app/measurement.h"
 #include "render/core/error.h"
+#include "render/film/atomic_file.h"
 #include "render/film/image_io.h"
 
 namespace vpl::app {
@@ -81,7 +82,7 @@ int runSweep(const SweepOptions& sweep, const RenderOptions& render, const CLI::
   const std::string &csvPath = paths[0], &tablePath = paths[1];
   tbb::global_control threads(tbb::global_control::max_allowed_parallelism, render.threadCount());
 
-  std::ofstream csv(csvPath), table(tablePath);
+  std::ostringstream csv, table;  // written whole at the end (atomic_file.h): no half-written table
   csv << "parameter,value,mode,budget,seconds,spp,relmse,bias\n";
   table << "| parameter | value | mode | budget | spp | relMSE | vs defaults |\n|---|---|---|---|---|---|---|\n";
   const bool terminal = isatty(STDERR_FILENO) != 0;
@@ -113,9 +114,8 @@ int runSweep(const SweepOptions& sweep, const RenderOptions& render, const CLI::
                  baseline.relmse);
         }
     }
-  csv.close();
-  table.close();
-  if (!csv || !table) throw InputError(sweep.outDir + ": cannot write the sweep's files");
+  writeFileAtomically(csvPath, csv.str());
+  writeFileAtomically(tablePath, table.str());
 
   nlohmann::ordered_json j = measurementSummary("sweep", defaults, sweep.reference, runs * size_t(sweep.repeats));
   j["csv"] = csvPath;

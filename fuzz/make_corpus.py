@@ -144,11 +144,12 @@ def inlined(name):
     write(name + ".glb", glb(doc, binary))
 
 
-os.makedirs(out, exist_ok=True)
-write("triangle.gltf", triangle_doc(data_uri("application/octet-stream", TRIANGLE)))
-write("textured_quad.gltf", textured_quad())
-write("strip_fan.gltf", strip_and_fan())
-write("external.gltf", external())
-write("triangle.glb", glb_triangle())
-for scene in ("cornell_box", "cornell_glossy", "two_rooms"):
-    inlined(scene)
+if __name__ == "__main__":  # tests/data/gltf_indices/make_files.py imports the helpers above
+    os.makedirs(out, exist_ok=True)
+    write("triangle.gltf", triangle_doc(data_uri("application/octet-stream", TRIANGLE)))
+    write("textured_quad.gltf", textured_quad())
+    write("strip_fan.gltf", strip_and_fan())
+    write("external.gltf", external())
+    write("triangle.glb", glb_triangle())
+    for scene in ("cornell_box", "cornell_glossy", "two_rooms"):
+        inlined(scene)

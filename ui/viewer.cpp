@@ -11,6 +11,7 @@
 #include <imgui.h>
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_opengl3.h>
+#include "render/core/error.h"
 #include "render/film/image_io.h"
 #include "render/scene/camera.h"
 #include "render/scene/gltf_loader.h"
@@ -49,6 +50,20 @@ class GlfwLibrary {
   bool ok_ = false;
 };
 
+// Saves an image through `write`; a failure (InputError) is one line on stderr and in `message`.
+template <class Write>
+bool save(const std::string& path, Write write, std::string& message) {
+  try {
+    write(path);
+    message = "saved " + path;
+    return true;
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "vplview: %s\n", e.what());
+    message = e.what();
+    return false;
+  }
+}
+
 // The panel's editable copy of the settings that need a new session when applied.
 struct PanelSettings {
   int vpls;
@@ -63,7 +78,9 @@ struct PanelSettings {
 
 int runViewer(const ViewerOptions& options) {
   // The scene first: a file that does not load never opens a window.
-  auto scene = std::make_shared<const RenderScene>(loadGltf(options.scenePath), options.sky);
+  SceneData data = loadGltf(options.scenePath);
+  for (const std::string& notice : data.notices) std::fprintf(stderr, "vplview: note: %s\n", notice.c_str());
+  auto scene = std::make_shared<const RenderScene>(std::move(data), options.sky);
   GlfwLibrary glfw;
   if (!glfw.ok()) {
     std::fprintf(stderr, "vplview: cannot open a window (no display?); use 'vplview render' or 'vplview capture'\n");
@@ -220,15 +237,14 @@ int runViewer(const ViewerOptions& options) {
             version = 0;
           }
         }
-        if (ImGui::Button("screenshot PNG")) {
-          writePngBytes("vplview_screenshot.png", fbWidth, fbHeight, display.readPixels(fbWidth, fbHeight));
-          message = "saved vplview_screenshot.png";
-        }
+        // A failed save is reported and the session goes on; the earlier file stays as it was.
+        if (ImGui::Button("screenshot PNG"))
+          save("vplview_screenshot.png", [&](const std::string& path) {
+            writePngBytes(path, fbWidth, fbHeight, display.readPixels(fbWidth, fbHeight));
+          }, message);
         ImGui::SameLine();
-        if (ImGui::Button("save EXR") && image.width > 0) {
-          writeExr("vplview_image.exr", image);
-          message = "saved vplview_image.exr";
-        }
+        if (ImGui::Button("save EXR") && image.width > 0)
+          save("vplview_image.exr", [&](const std::string& path) { writeExr(path, image); }, message);
         if (!message.empty()) ImGui::TextUnformatted(message.c_str());
         ImGui::End();
       }
@@ -238,9 +254,16 @@ int runViewer(const ViewerOptions& options) {
       if (fbWidth > 0 && fbHeight > 0) {
         display.draw(fbWidth, fbHeight, exposure, DisplayView(view));
         // What the window shows: read before the panel is drawn over it, unless it is wanted.
-        if (shoot && !options.screenshotPanel) writePngBytes(options.screenshot, fbWidth, fbHeight, display.readPixels(fbWidth, fbHeight));
+        // --screenshot: a failed write ends the viewer with status 2 (DESIGN.md §3), after cleaning up.
+        auto screenshot = [&] {
+          const auto write = [&](const std::string& path) {
+            writePngBytes(path, fbWidth, fbHeight, display.readPixels(fbWidth, fbHeight));
+          };
+          if (!save(options.screenshot, write, message)) exitStatus = 2;
+        };
+        if (shoot && !options.screenshotPanel) screenshot();
         ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-        if (shoot && options.screenshotPanel) writePngBytes(options.screenshot, fbWidth, fbHeight, display.readPixels(fbWidth, fbHeight));
+        if (shoot && options.screenshotPanel) screenshot();
         if (shoot) glfwSetWindowShouldClose(window, GLFW_TRUE);
       }
       glfwSwapBuffers(window);

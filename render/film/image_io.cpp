@@ -2,15 +2,18 @@
 
 #include <cmath>
 #include <cstdint>
+#include <string>
 #include <vector>
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
+#include <ImfStdIO.h>
 #include <stb_image.h>
 #include <stb_image_write.h>
 #include "render/core/error.h"
+#include "render/film/atomic_file.h"
 #include "render/film/tonemap.h"
 
 namespace vpl {
@@ -37,10 +40,12 @@ size_t writeExr(const std::string& path, const Image& image) {
   if (image.width <= 0 || image.height <= 0) throw InputError(path + ": cannot write an empty image");
   std::vector<float> rgb;
   const size_t bad = sanitized(image, rgb);
+  // Encoded in memory, then written in one piece: a failed write never truncates an earlier file.
+  Imf::StdOSStream encoded;
   try {
     Imf::Header header(image.width, image.height);
     for (const char* name : {"R", "G", "B"}) header.channels().insert(name, Imf::Channel(Imf::FLOAT));
-    Imf::OutputFile file(path.c_str(), header);
+    Imf::OutputFile file(encoded, header);  // its destructor writes the line offsets: scope ends before str()
     Imf::FrameBuffer fb;
     const size_t xStride = 3 * sizeof(float), yStride = xStride * size_t(image.width);
     char* base = reinterpret_cast<char*>(rgb.data());
@@ -52,6 +57,7 @@ size_t writeExr(const std::string& path, const Image& image) {
   } catch (const std::exception& e) {
     throw InputError(path + ": cannot write OpenEXR (" + e.what() + ")");
   }
+  writeFileAtomically(path, encoded.str());
   return bad;
 }
 
@@ -100,7 +106,11 @@ size_t writePng(const std::string& path, const Image& image, float exposureStops
 void writePngBytes(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb) {
   if (width <= 0 || height <= 0 || rgb.size() != size_t(width) * size_t(height) * 3)
     throw InputError(path + ": cannot write an empty or mis-sized image");
-  if (!stbi_write_png(path.c_str(), width, height, 3, rgb.data(), width * 3)) throw InputError(path + ": cannot write PNG");
+  std::string encoded;
+  const auto append = [](void* out, void* bytes, int n) { static_cast<std::string*>(out)->append(static_cast<char*>(bytes), size_t(n)); };
+  if (!stbi_write_png_to_func(append, &encoded, width, height, 3, rgb.data(), width * 3))
+    throw InputError(path + ": cannot encode PNG");
+  writeFileAtomically(path, encoded);
 }
 
 Image readPng(const std::string& path) {

@@ -1,5 +1,5 @@
 // Image files: OpenEXR (linear float RGB, for references and measurements) and PNG (sRGB, for eyes).
-// Every failure is an InputError naming the path.
+// Every failure is an InputError naming the path; writes are atomic (render/film/atomic_file.h).
 #pragma once
 #include <cstdint>
 #include <string>

@@ -14,6 +14,7 @@
 #include "render/core/error.h"
 #include "render/scene/gltf_accessor.h"
 #include "render/scene/gltf_materials.h"
+#include "render/scene/gltf_validate.h"
 
 namespace vpl {
 
@@ -166,6 +167,8 @@ class SceneBuilder {
     for (int r : roots) visit(r, glm::mat4(1.0f), onPath, 0);
     if (degenerate_ > 0)
       scene_.notices.push_back(std::to_string(degenerate_) + " degenerate (zero-area) triangles skipped");
+    // Valid, but most likely not what the author meant: say so rather than show an empty sky.
+    if (scene_.meshes.empty()) scene_.notices.push_back("the scene instances no triangles: only the sky will be seen");
     if (scene_.materials.empty()) scene_.materials.push_back(Material{});
     computeBounds();
     return std::move(scene_);
@@ -379,26 +382,28 @@ SceneData loadGltf(const fs::path& path, const LoadLimits& limits) {
   if (ec) throw InputError(file + ": cannot read");
   if (size > limits.maxBufferBytes) throw InputError(file + ": larger than the size limit");
 
-  char magic[4] = {};
-  {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw InputError(file + ": cannot open");
-    in.read(magic, 4);
-  }
   LoadContext ctx;
   ctx.root = fs::weakly_canonical(fs::absolute(path), ec).parent_path();
   ctx.limits = limits;
   ctx.file = file;
 
+  // Read once, through the same checked callback tinygltf uses for the files the scene names.
+  const std::string full = fs::absolute(path).string();
+  std::vector<unsigned char> bytes;
+  std::string err, warn;
+  if (!readWholeFile(&bytes, &err, full, &ctx)) throw InputError(file + ": " + ctx.firstError);
+  if (bytes.empty()) throw InputError(file + ": empty file");
+  const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
+  gltf::checkIndices(bytes.data(), bytes.size(), binary, file);
+
   tinygltf::TinyGLTF loader;
   loader.SetFsCallbacks({fileExists, expandPath, readWholeFile, writeWholeFile, &ctx});
   loader.SetImageLoader(loadImage, &ctx);
   tinygltf::Model model;
-  std::string err, warn;
-  const bool binary = std::memcmp(magic, "glTF", 4) == 0;
-  const std::string full = fs::absolute(path).string();
-  const bool ok = binary ? loader.LoadBinaryFromFile(&model, &err, &warn, full)
-                         : loader.LoadASCIIFromFile(&model, &err, &warn, full);
+  const std::string baseDir = fs::path(full).parent_path().string();  // URIs resolve from here
+  const bool ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(), unsigned(bytes.size()), baseDir)
+                         : loader.LoadASCIIFromString(&model, &err, &warn, reinterpret_cast<const char*>(bytes.data()),
+                                                      unsigned(bytes.size()), baseDir);
   if (!ok) {
     std::string why = !ctx.firstError.empty() ? ctx.firstError : firstLine(err);
     if (why.empty()) why = binary ? "not a valid GLB file" : "not a valid glTF file";
