@@ -9,8 +9,9 @@
 # budget and seed, alternating: Cycles at a fixed spp chosen from two probes so that it takes about the
 # budget, then vplview brdf and mis with --time set to the seconds Cycles reported. Every image is
 # scored with `vplview compare IMAGE REF` (relMSE and relative bias).
-# Writes OUT_DIR/vs_cycles.csv (one row per render; rows of budgets not rerun are kept, so 10 and 60
-# can be run separately) and OUT_DIR/vs_cycles.md (tables for the README), and prints the latter.
+# Writes OUT_DIR/vs_cycles.csv (one row per render; rows of budgets or scenes not rerun are kept, so
+# 10 and 60, or one scene, can be run again separately) and OUT_DIR/vs_cycles.md (tables for the
+# README), and prints the latter.
 #
 # Environment: THREADS (2), SEEDS ("1 2"), MAX_DEPTH (32 = vplview's default; Cycles gets
 # --max-bounces MAX_DEPTH-1), SCENES (names to run, default all built-in), REF_SPP (overrides the
@@ -53,12 +54,13 @@ json() { python3 -c 'import json,sys; j=json.loads(sys.stdin.read().strip().spli
 tmp_csv=$(mktemp)
 echo "$header" > "$tmp_csv"
 if [ -f "$csv" ]; then
-  python3 - "$csv" "$budgets" >> "$tmp_csv" <<'PY'
+  python3 - "$csv" "$budgets" "${SCENES:-}" >> "$tmp_csv" <<'PY'
 import csv, sys
 rerun = {float(b) for b in sys.argv[2].split()}
+scenes = set(sys.argv[3].split())  # empty: every scene is rerun
 rows = list(csv.reader(open(sys.argv[1])))
 for r in rows[1:]:
-    if r and float(r[1]) not in rerun:
+    if r and (float(r[1]) not in rerun or (scenes and r[0] not in scenes)):
         print(",".join(r))
 PY
 fi
