@@ -41,9 +41,13 @@ bool GuidedContinuation::sample(const SurfaceHit& hit, const Bsdf& bsdf, const g
                                 DirectionSample& out, PathStats& stats) {
   const int c = servingCachePoint(hit, bsdf);
   const float pBsdf = c < 0 ? 1.0f : bsdfProbability();
-  // Only a real choice draws a number: the strategy dimension stays unused where one strategy is certain.
-  if (pBsdf >= 1.0f || (pBsdf > 0.0f && u.strategy() < pBsdf)) {
-    const auto s = bsdf.sample(wo, u.bsdfDirection());
+  // The strategy is the BSDF direction's x, rescaled within the BSDF's share (as Bsdf::sample picks
+  // its lobe): the BSDF's directions then stay a stratified set, which a separate strategy number
+  // would thin out at random (mis gained 0.54x per sample from the stratified sampler, brdf 0.34x).
+  glm::vec2 uBsdf = pBsdf > 0.0f ? u.bsdfDirection() : glm::vec2(0.0f);
+  if (pBsdf >= 1.0f || uBsdf.x < pBsdf) {
+    if (pBsdf < 1.0f) uBsdf.x = std::min(uBsdf.x / pBsdf, 0x1.fffffep-1f);
+    const auto s = bsdf.sample(wo, uBsdf);
     if (!s) return false;
     out.wi = s->wi;
     ++stats.bsdfSamples;

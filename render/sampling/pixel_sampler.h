@@ -25,7 +25,7 @@ enum class VertexDimension : uint32_t {
   LightPoint,           // the point on the chosen emitter (next-event estimation)
   BsdfDirection,        // the BSDF's direction; x also picks its lobe (Bsdf::sample(wo, u))
   LightChoiceRoulette,  // x: which emitter; y: Russian roulette
-  StrategyGuideCell,    // x: BSDF or guide (one-sample MIS); y: the guide's cell or its defensive share
+  StrategyGuideCell,    // x: a free 1D choice (mis takes its strategy from BsdfDirection's x); y: the guide's cell or its defensive share
   GuidePoint,           // the point within the guide's cell
   Count
 };
