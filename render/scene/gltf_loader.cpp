@@ -9,10 +9,10 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
-#include <stb_image.h>
 #include <tiny_gltf.h>
 #include "render/core/error.h"
 #include "render/scene/gltf_accessor.h"
+#include "render/scene/gltf_image.h"
 #include "render/scene/gltf_materials.h"
 #include "render/scene/gltf_validate.h"
 
@@ -90,32 +90,25 @@ bool writeWholeFile(std::string* err, const std::string&, const std::vector<unsi
   return false;
 }
 
-// Decodes an image only after its header says it fits the pixel limit.
+// tinygltf's image callback: decodeImage (gltf_image.h) under the pixel limit; its refusal becomes
+// the loader's first error.
 bool loadImage(tinygltf::Image* image, const int index, std::string* err, std::string*, int, int,
                const unsigned char* bytes, int size, void* user) {
   auto* ctx = static_cast<LoadContext*>(user);
-  int w = 0, h = 0, comp = 0;
-  auto fail = [&](const std::string& message) {
-    if (ctx->firstError.empty()) ctx->firstError = message;
-    if (err) *err += message;
+  try {
+    gltf::DecodedImage decoded = gltf::decodeImage(bytes, size_t(std::max(size, 0)), ctx->limits.maxImagePixels, index);
+    image->width = decoded.width;
+    image->height = decoded.height;
+    image->component = 4;
+    image->bits = 8;
+    image->pixel_type = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
+    image->image = std::move(decoded.rgba);
+    return true;
+  } catch (const InputError& e) {
+    if (ctx->firstError.empty()) ctx->firstError = e.what();
+    if (err) *err += e.what();
     return false;
-  };
-  if (!stbi_info_from_memory(bytes, size, &w, &h, &comp))
-    return fail("image " + std::to_string(index) + " is not a decodable PNG/JPEG (" +
-                (stbi_failure_reason() ? stbi_failure_reason() : "unknown") + ")");
-  if (w <= 0 || h <= 0 || uint64_t(w) * uint64_t(h) > ctx->limits.maxImagePixels)
-    return fail("image " + std::to_string(index) + " claims " + std::to_string(w) + "x" + std::to_string(h) +
-                " pixels, more than the limit");
-  unsigned char* data = stbi_load_from_memory(bytes, size, &w, &h, &comp, 4);
-  if (!data) return fail("image " + std::to_string(index) + " could not be decoded");
-  image->width = w;
-  image->height = h;
-  image->component = 4;
-  image->bits = 8;
-  image->pixel_type = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
-  image->image.assign(data, data + size_t(w) * size_t(h) * 4);
-  stbi_image_free(data);
-  return true;
+  }
 }
 
 std::string firstLine(const std::string& s) {

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include "render/core/error.h"
-#include "render/film/tonemap.h"
+#include "render/scene/gltf_image.h"
 
 namespace vpl::gltf {
 
@@ -45,26 +45,10 @@ int MaterialConverter::texture(int textureIndex, int texCoordIn, bool srgb, int&
   if (auto it = textures_.find(key); it != textures_.end()) return it->second;
 
   const tinygltf::Image& img = model_.images[size_t(image)];
-  const int channels = img.component;
-  if (img.width <= 0 || img.height <= 0 || channels < 1 || channels > 4 || img.bits != 8 ||
-      img.image.size() < size_t(img.width) * size_t(img.height) * size_t(channels))
-    throw InputError(file_ + ": image " + std::to_string(image) + " could not be decoded");
-  Texture t;
-  t.width = img.width;
-  t.height = img.height;
-  t.texels.resize(size_t(img.width) * size_t(img.height));
-  // 8-bit decode through a 256-entry table: colour textures are sRGB-encoded, data textures linear.
-  float lut[256];
-  for (int i = 0; i < 256; ++i) lut[i] = srgb ? srgbToLinear(i / 255.0f) : i / 255.0f;
-  for (size_t p = 0; p < t.texels.size(); ++p) {
-    const unsigned char* px = &img.image[p * size_t(channels)];
-    glm::vec4 v(1.0f);
-    if (channels >= 3) v = glm::vec4(lut[px[0]], lut[px[1]], lut[px[2]], channels == 4 ? px[3] / 255.0f : 1.0f);
-    else v = glm::vec4(lut[px[0]], lut[px[0]], lut[px[0]], channels == 2 ? px[1] / 255.0f : 1.0f);
-    t.texels[p] = v;
-  }
+  std::optional<Texture> t = makeTexture(img.width, img.height, img.component, img.bits, img.image, srgb);
+  if (!t) throw InputError(file_ + ": image " + std::to_string(image) + " could not be decoded");
   const int index = int(scene_.textures.size());
-  scene_.textures.push_back(std::move(t));
+  scene_.textures.push_back(std::move(*t));
   textures_[key] = index;
   return index;
 }

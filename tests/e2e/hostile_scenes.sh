@@ -23,6 +23,7 @@ def scene(name, uri=inline, count=3, extra=None):
     doc.update(extra or {})
     json.dump(doc, open(os.path.join(tmp, "scene", name), "w"))
 png = b"\x89PNG\r\n\x1a\n" + struct.pack(">I", 13) + b"IHDR" + struct.pack(">IIBBBBB", 16384, 16384, 8, 6, 0, 0, 0) + b"CRC!"
+png += struct.pack(">I", 2) + b"IDATx\x9c" + b"CRC!"  # stb_image reads the header up to the first IDAT
 scene("accessor_24GB.gltf", count=2_000_000_000)
 scene("accessor_1.5GB_in_36_bytes.gltf", count=125_000_000)
 scene("image_16384x16384.gltf", extra={"images": [{"uri": "data:image/png;base64," + base64.b64encode(png).decode()}]})

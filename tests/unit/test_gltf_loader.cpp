@@ -265,7 +265,9 @@ std::string pngHeader(uint32_t w, uint32_t h) {
   std::string png = "\x89PNG\r\n\x1a\n" + std::string("\0\0\0\x0d", 4) + "IHDR";
   for (uint32_t v : {w, h})
     for (int shift = 24; shift >= 0; shift -= 8) png += char((v >> shift) & 0xff);
-  return png + std::string("\x08\x06\0\0\0", 5) + "CRC!";
+  // stb_image 2.30 reads the header up to the first IDAT (a tRNS may come before it): one follows,
+  // with two bytes of a zlib stream and no more.
+  return png + std::string("\x08\x06\0\0\0", 5) + "CRC!" + std::string("\0\0\0\x02", 4) + "IDATx\x9c" + "CRC!";
 }
 
 TEST_F(BrokenFile, ImageHeadersClaimingTooManyPixelsAreRefusedBeforeDecoding) {
