@@ -19,6 +19,7 @@ bool BsdfContinuation::sample(const SurfaceHit&, const Bsdf& bsdf, const glm::ve
   ++stats.bsdfSamples;
   out.wi = s->wi;
   out.pdf = s->pdf;
+  out.weight = s->weight;
   return true;
 }
 
@@ -76,9 +77,9 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
     // Continuation direction.
     DirectionSample next;
     if (!continuation.sample(surface, bsdf, wo, u, next, stats)) break;
-    const glm::vec3 f = bsdf.eval(wo, next.wi);
-    if (isBlack(f) || glm::dot(next.wi, surface.geometricNormal) <= 0.0f) break;
-    beta *= f / next.pdf;
+    const glm::vec3 weight = next.weight.x >= 0.0f ? next.weight : bsdf.eval(wo, next.wi) / next.pdf;
+    if (isBlack(weight) || glm::dot(next.wi, surface.geometricNormal) <= 0.0f) break;
+    beta *= weight;
     if (!isFiniteNonNegative(beta)) break;
 
     // Russian roulette on the throughput (after a few bounces, so short paths keep full weight).

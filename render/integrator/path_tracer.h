@@ -41,6 +41,9 @@ struct PathStats {
 struct DirectionSample {
   glm::vec3 wi{0.0f};
   float pdf = 0.0f;  // solid angle density of the strategy as a whole (the density MIS needs)
+  // f cos / pdf when the strategy already has it (plain BSDF sampling), so the tracer need not
+  // evaluate the BSDF again; negative: not known, the tracer evaluates it.
+  glm::vec3 weight{-1.0f};
 };
 
 class ContinuationSampler {
