@@ -66,7 +66,10 @@ class IndexChecker {
       for (const char* part : {"indices", "values"})
         if (const json* p = member(sparse, part)) index(*p, "bufferView", at + ".sparse." + part, views, "a bufferView");
     });
-    each("bufferViews", [&](const json& v, const std::string& at) { index(v, "buffer", at, count(root_, "buffers"), "a buffer"); });
+    each("bufferViews", [&](const json& v, const std::string& at) {
+      index(v, "buffer", at, count(root_, "buffers"), "a buffer");
+      viewInsideBuffer(v, at);
+    });
     each("skins", [&](const json& s, const std::string& at) {
       index(s, "inverseBindMatrices", at, accessors, "an accessor");
       index(s, "skeleton", at, nodes, "a node");
@@ -123,6 +126,24 @@ class IndexChecker {
   }
   void textureInfo(const json* parent, const char* key, const std::string& at, size_t textures) {
     if (const json* info = member(parent, key)) index(*info, "index", join(at, key), textures, "a texture");
+  }
+
+  // A view's bytes must lie inside its buffer: tinygltf hands an image's view to the decoder
+  // unchecked, and a view past a 114-byte buffer had stb_image read beyond it (found by
+  // fuzz_gltf_loader, fuzz/regressions/image_view_past_buffer.glb).
+  void viewInsideBuffer(const json& view, const std::string& at) {
+    const json* buffers = member(&root_, "buffers");
+    const json* b = member(&view, "buffer");
+    const json* length = member(&view, "byteLength");
+    const json* offset = member(&view, "byteOffset");
+    if (!buffers || !buffers->is_array() || !b || !b->is_number_unsigned() || !length || !length->is_number_unsigned()) return;
+    const json* bufferLength = member(&(*buffers)[b->get<size_t>()], "byteLength");
+    if (!bufferLength || !bufferLength->is_number_unsigned()) return;
+    const uint64_t start = offset && offset->is_number_unsigned() ? offset->get<uint64_t>() : 0;
+    const uint64_t end = start + length->get<uint64_t>(), size = bufferLength->get<uint64_t>();
+    if (end >= start && end <= size) return;
+    throw InputError(file_ + ": " + at + ": bytes " + std::to_string(start) + " to " + std::to_string(end) + " run past buffer " +
+                     std::to_string(b->get<size_t>()) + " (" + std::to_string(size) + " bytes)");
   }
 
   void check(const json& v, const std::string& path, size_t size, const char* what) {
