@@ -51,6 +51,11 @@ bool GuidedContinuation::sample(const SurfaceHit& hit, const Bsdf& bsdf, const g
     if (!s) return false;
     out.wi = s->wi;
     ++stats.bsdfSamples;
+    if (pBsdf >= 1.0f) {  // an unguided vertex: the sample's own pdf and weight are the strategy's
+      out.pdf = s->pdf;
+      out.weight = s->weight;
+      return true;
+    }
   } else {
     const GuideDistribution& guide = field_.point(c).distribution;
     const bool revisit = std::find(chainsUsedByPath_.begin(), chainsUsedByPath_.end(), c) != chainsUsedByPath_.end();
