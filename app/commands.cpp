@@ -48,6 +48,10 @@ nlohmann::ordered_json summaryJson(const RenderJobSettings& s, const RenderJobRe
   j["seconds"] = r.seconds;
   j["timings"] = {{"load", r.timings.load}, {"bvh", r.timings.bvh}, {"vpl", r.timings.vpl},
                   {"cluster", r.timings.cluster}, {"render", r.timings.render}};
+  if (s.mode != SamplingMode::Brdf)
+    j["cluster_stages"] = {{"gather", r.timings.gather},          {"slices", r.timings.slices},
+                           {"matrix", r.timings.matrix},          {"global", r.timings.globalClusters},
+                           {"refine", r.timings.refine},          {"guide", r.timings.guide}};
   j["first_image_s"] = r.firstImageSeconds;
   j["rays"] = r.rays;
   j["rays_per_s"] = r.timings.render > 0 ? double(r.rays) / r.timings.render : 0.0;

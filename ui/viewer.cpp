@@ -12,6 +12,7 @@
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_opengl3.h>
 #include "render/core/error.h"
+#include "render/core/stopwatch.h"
 #include "render/film/image_io.h"
 #include "render/scene/camera.h"
 #include "render/scene/gltf_loader.h"
@@ -22,8 +23,7 @@ namespace vpl::ui {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+using Clock = SteadyClock;
 
 constexpr double kFrameSeconds = 1.0 / 60.0;
 
@@ -270,9 +270,9 @@ int runViewer(const ViewerOptions& options) {
       ++framesSinceLog;
       // The screenshot's frame is always logged: a script can tell which stage it shows.
       if (log && (secondsSince(lastLog) >= 1.0 || shoot)) {
-        std::fprintf(log, "t %.2f fps %.1f stage %s spp %d first_frame_ms %.1f samples_per_s %.4g\n", secondsSince(opened),
-                     framesSinceLog / secondsSince(lastLog), stageName(stats.stage), stats.spp,
-                     1e3 * stats.firstFrameSeconds, stats.samplesPerSecond);
+        std::fprintf(log, "t %.2f fps %.1f stage %s spp %d first_frame_ms %.1f first_preview_ms %.1f samples_per_s %.4g\n",
+                     secondsSince(opened), framesSinceLog / secondsSince(lastLog), stageName(stats.stage), stats.spp,
+                     1e3 * stats.firstFrameSeconds, 1e3 * stats.firstPreviewSeconds, stats.samplesPerSecond);
         std::fflush(log);
         framesSinceLog = 0;
         lastLog = Clock::now();

@@ -6,6 +6,7 @@
 #include <numeric>
 #include <queue>
 #include <tbb/parallel_for.h>
+#include "render/core/stopwatch.h"
 #include "render/sampling/distribution_1d.h"
 #include "render/sampling/rng.h"
 
@@ -155,6 +156,7 @@ LightSliceResult clusterLightSlice(std::span<const Vpl> vpls, std::span<const Ga
   result.slices.resize(sliceCount);
   if (n == 0 || sliceCount == 0) return result;
   std::atomic<uint64_t> evaluations{0};
+  Stopwatch stopwatch;
   const VplFigures figures(vpls);
 
   // 1. Reduced light matrix: rows at evenly spread slices (a seeded stride through the slices).
@@ -171,6 +173,7 @@ LightSliceResult clusterLightSlice(std::span<const Vpl> vpls, std::span<const Ga
     for (uint32_t j = j0; j < j1; ++j) matrix[size_t(r) * n + j] = transport.contribution(rowSlice[r], j, true);
     evaluations += j1 - j0;
   });
+  result.matrixSeconds = stopwatch.lap();
 
   // 2. Global clustering over all reduced rows: seeds drawn by column norm, every column joins the
   //    seed it is most aligned with (MRCS's sampling clustering); columns that are zero in every
@@ -221,6 +224,7 @@ LightSliceResult clusterLightSlice(std::span<const Vpl> vpls, std::span<const Ga
   for (uint32_t j = 0; j < n; ++j) globalClusters[globalOf[j]].push_back(j);
   std::erase_if(globalClusters, [](const auto& c) { return c.empty(); });
   result.globalClusterCount = uint32_t(globalClusters.size());
+  result.globalSeconds = stopwatch.lap();
 
   // 3. Per-slice refinement (LightSlice §4.2) on the slice's own row (its representative, unoccluded:
   //    one cheap evaluation per VPL) and the reduced rows nearest it (6D distance, with visibility).
@@ -300,6 +304,7 @@ LightSliceResult clusterLightSlice(std::span<const Vpl> vpls, std::span<const Ga
     evaluations += evals;
   });
   result.evaluations = evaluations.load();
+  result.refineSeconds = stopwatch.lap();
   return result;
 }
 

@@ -58,6 +58,9 @@ struct LightSliceResult {
   std::vector<SliceClusters> slices;
   uint32_t globalClusterCount = 0;
   uint64_t evaluations = 0;  // contribution() calls
+  // Wall seconds of the three steps: the reduced matrix (shadow rays), the global clustering, the
+  // per-slice refinement with the clusters' estimates.
+  double matrixSeconds = 0.0, globalSeconds = 0.0, refineSeconds = 0.0;
 };
 
 // When *cancel becomes true the remaining work is skipped: the result is then valid (every slice has

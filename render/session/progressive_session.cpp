@@ -4,6 +4,7 @@
 #include <map>
 #include <tbb/info.h>
 #include <tbb/task_arena.h>
+#include "render/core/stopwatch.h"
 #include "render/film/film.h"
 #include "render/guide/guide_builder.h"
 #include "render/integrator/guided_continuation.h"
@@ -13,8 +14,7 @@ namespace vpl {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+using Clock = SteadyClock;
 
 // The quick stage renders at this fraction of the size, and keeps refining it until the camera has
 // been still this long: only then does the (not cancellable) clustering start.
@@ -174,6 +174,7 @@ void ProgressiveSession::controllerLoop() {
       state.renderSeconds = seconds;
       std::lock_guard lock(mutex_);
       ++stats_.restarts;
+      stats_.firstPreviewSeconds = 0.0;
     }
     state.key = request;
     arena.execute([&] { runUntilChanged(state, request); });
@@ -192,6 +193,10 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
   auto noteTime = [&] {
     std::lock_guard lock(mutex_);
     stats_.sinceRestart = secondsSince(state.restart);
+  };
+  auto notePreview = [&] {
+    std::lock_guard lock(mutex_);
+    if (stats_.firstPreviewSeconds == 0.0) stats_.firstPreviewSeconds = secondsSince(state.restart);
   };
 
   // 1. Quick: quarter-size BSDF passes until the camera has been still for a moment.
@@ -224,11 +229,23 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
     }
     const double vplSeconds = secondsSince(t);
     t = Clock::now();
-    PreviewSettings preview = settings_.preview;
+    PreviewSettings preview = settings_.maxSlices > 0 ? withAtMostSlices(settings_.preview, size_t(w) * size_t(h), settings_.maxSlices)
+                                                      : settings_.preview;
     preview.clustering.seed = settings_.seed;
-    // LightSlice's cost grows with the slice count: a large window gets larger slices, not more.
-    if (settings_.maxSlices > 0)
-      preview.slices.maxSliceSize = std::max(preview.slices.maxSliceSize, (w * h + settings_.maxSlices - 1) / settings_.maxSlices);
+    if (settings_.coarsePreview) {
+      // One coarse pass on screen while the full clustering runs; its film is not kept.
+      const int divisor = coarsePreviewDivisor(w, h);
+      const Camera coarseCamera(request.camera, std::max(1, w / divisor), std::max(1, h / divisor));
+      const size_t coarsePixels = size_t(coarseCamera.width()) * size_t(coarseCamera.height());
+      const PreviewSettings coarse = coarsePreviewSettings(preview, coarsePixels);
+      const VplField coarseField = buildVplField(scene, coarseCamera, vpls_, coarse, &cancel_);
+      if (cancelled()) return;
+      Film film(coarseCamera.width(), coarseCamera.height());
+      TileRenderer(coarseCamera, settings_.seed, previewShader(scene, coarseField, coarse)).renderPass(film, 0, &cancel_);
+      if (cancelled()) return;
+      publish(divisor > 1 ? upscaleNearest(film.resolve(), w, h) : film.resolve(), SessionStage::Preview, 1);
+      notePreview();
+    }
     auto field = std::make_unique<VplField>(buildVplField(scene, camera, vpls_, preview, &cancel_));
     if (cancelled()) return;  // incomplete: built again when this view comes back
     state.field = std::move(field);
@@ -252,6 +269,7 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
     if (cancelled()) return;
     ++preview.complete;
     publish(preview.film->resolve(), SessionStage::Preview, preview.complete);
+    notePreview();
     noteTime();
   }
   if (request.mode == SamplingMode::Preview) return;

@@ -2,8 +2,9 @@
 // the passes on a TBB arena of `threads` workers; the UI thread only posts changes (camera, mode,
 // size) and picks up the newest image, so it never waits for a pass. After every restart:
 //   1. quick     a 1-spp BSDF pass at a quarter of the resolution: a whole new frame at once
-//   2. preview   this camera's gather points, slices and LightSlice clusters (the VPLs themselves are
-//                traced once per scene and kept), then `previewPasses` preview passes
+//   2. preview   first one pass of a coarse preview (few slices, few clusters per pixel: fast), then
+//                this camera's gather points, slices and LightSlice clusters in full (the VPLs themselves
+//                are traced once per scene and kept), then `previewPasses` preview passes
 //   3. refine    the guide (guided modes), then path-traced passes into the mode's own film, until
 //                `maxSpp`
 // The shown image is the newest stage with something to show; the path-traced film takes over once
@@ -37,6 +38,7 @@ struct SessionSettings {
   int handoverSpp = 16;      // path-traced samples before the display leaves the preview
   int maxSpp = 1 << 16;      // the controller idles after this many path-traced samples
   int maxSlices = 384;       // slices (cache points) per view at most; 0: preview.slices alone decides
+  bool coarsePreview = true;  // show a coarse preview pass before the full clustering
   PathTracerSettings tracer;
   PreviewSettings preview;
   GuideSettings guide;
@@ -51,6 +53,7 @@ struct SessionStats {
   int spp = 0;                   // samples per pixel of the image shown (preview: passes)
   double sinceRestart = 0.0;     // seconds since the last restart
   double firstFrameSeconds = 0.0;  // restart -> first full frame (the quick pass)
+  double firstPreviewSeconds = 0.0;  // restart -> first preview image (coarse or full); 0 until then
   double samplesPerSecond = 0.0, raysPerSecond = 0.0;  // of the path-traced passes so far
   double vplSeconds = 0.0, clusterSeconds = 0.0, guideSeconds = 0.0;
   size_t vpls = 0, cachePoints = 0;

@@ -6,19 +6,19 @@
 #include <mutex>
 #include <thread>
 #include "render/core/error.h"
+#include "render/core/stopwatch.h"
 #include "render/film/film.h"
+#include "render/guide/guide_builder.h"
+#include "render/integrator/guided_continuation.h"
 #include "render/scene/camera.h"
 #include "render/scene/gltf_loader.h"
 #include "render/session/tile_renderer.h"
-#include "render/guide/guide_builder.h"
-#include "render/integrator/guided_continuation.h"
 
 namespace vpl {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+using Clock = SteadyClock;
 
 // Raises a stop flag at a deadline, or earlier when destroyed.
 class DeadlineWatch {
@@ -96,6 +96,11 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
     preview.clustering.seed = settings.seed;
     field = buildVplField(scene, camera, vpls, preview);
     result.timings.cluster = secondsSince(t);
+    result.timings.gather = field.gatherSeconds;
+    result.timings.slices = field.sliceSeconds;
+    result.timings.matrix = field.clusters.matrixSeconds;
+    result.timings.globalClusters = field.clusters.globalSeconds;
+    result.timings.refine = field.clusters.refineSeconds;
     result.rays += field.rays;
     result.sliceCount = field.tree.slices.size();
     size_t clusterTotal = 0;
@@ -104,7 +109,9 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
     if (settings.mode == SamplingMode::Preview) {
       shader = previewShader(scene, field, settings.preview);
     } else {
+      const auto guideStart = Clock::now();
       guide = buildGuideField(scene, field, settings.guide);
+      result.timings.guide = secondsSince(guideStart);
       result.timings.cluster = secondsSince(t);
       result.guideBytes = guide.memoryBytes();
       const SamplingMode mode = settings.mode;

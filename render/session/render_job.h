@@ -31,6 +31,9 @@ struct RenderJobSettings {
 
 struct PhaseTimings {
   double load = 0, bvh = 0, vpl = 0, cluster = 0, render = 0;
+  // cluster's parts: gather points, slice tree, LightSlice (reduced matrix, global clusters, per-slice
+  // refinement) and, in the guided modes, the guide
+  double gather = 0, slices = 0, matrix = 0, globalClusters = 0, refine = 0, guide = 0;
 };
 
 struct RenderJobResult {

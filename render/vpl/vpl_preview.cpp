@@ -1,7 +1,9 @@
 #include "render/vpl/vpl_preview.h"
 
+#include <algorithm>
 #include <cmath>
 #include "render/core/color.h"
+#include "render/core/stopwatch.h"
 
 namespace vpl {
 
@@ -92,9 +94,12 @@ VplField buildVplField(const RenderScene& scene, const Camera& camera, std::shar
                        const PreviewSettings& settings, const std::atomic<bool>* cancel) {
   VplField field;
   field.vpls = std::move(vpls);
+  Stopwatch stopwatch;
   field.gather = gatherPrimaryHits(scene, camera);
+  field.gatherSeconds = stopwatch.lap();
   const float diagonal = 2.0f * scene.radius();
   field.tree = buildSliceTree(field.gather.points, settings.slices, diagonal);
+  field.sliceSeconds = stopwatch.lap();
   field.minDistance = settings.clampFraction * diagonal;
   const SliceTransport transport(scene, field);
   field.clusters = clusterLightSlice(field.vpls->vpls, field.gather.points, field.tree, transport, settings.clustering, cancel);
@@ -156,6 +161,20 @@ PixelShaderFactory previewShader(const RenderScene& scene, const VplField& field
       return L;
     };
   };
+}
+
+PreviewSettings withAtMostSlices(const PreviewSettings& s, size_t pixels, int maxSlices) {
+  PreviewSettings out = s;
+  const size_t slices = size_t(std::max(1, maxSlices));
+  out.slices.maxSliceSize = std::max<int>(s.slices.maxSliceSize, int(std::min<size_t>((pixels + slices - 1) / slices, 1u << 24)));
+  return out;
+}
+
+PreviewSettings coarsePreviewSettings(const PreviewSettings& full, size_t pixels, const CoarsePreview& coarse) {
+  PreviewSettings s = withAtMostSlices(full, pixels, coarse.slices);
+  s.clustering.reducedRows = std::min(full.clustering.reducedRows, std::max(1, coarse.slices));
+  s.clustersPerPass = std::clamp(coarse.clustersPerPass, 1, full.clustersPerPass);
+  return s;
 }
 
 }  // namespace vpl

@@ -43,6 +43,7 @@ struct VplField {
   std::vector<Distribution1D> clusterChoice;  // per slice: which cluster a pass samples
   float minDistance = 0.0f;                   // geometry-term clamp distance (world units)
   uint64_t rays = 0;
+  double gatherSeconds = 0.0, sliceSeconds = 0.0;  // wall time of those stages (LightSlice's are in `clusters`)
 };
 
 // The camera-dependent part; `vpls` is reused across camera moves. When *cancel becomes true the
@@ -51,5 +52,24 @@ VplField buildVplField(const RenderScene& scene, const Camera& camera, std::shar
                        const PreviewSettings& settings, const std::atomic<bool>* cancel = nullptr);
 
 PixelShaderFactory previewShader(const RenderScene& scene, const VplField& field, const PreviewSettings& settings);
+
+// `s` with slices large enough that `pixels` gather points make about `maxSlices` of them or fewer (the
+// kd-tree's median splits stop between half and twice that; LightSlice's cost grows with the slice
+// count: a large window gets larger slices, not more).
+PreviewSettings withAtMostSlices(const PreviewSettings& s, size_t pixels, int maxSlices);
+
+// A first preview, shown while the full one is built: the same VPLs, but about `slices` slices
+// (LightSlice's per-slice refinement, the dominant cost, shrinks with them) and fewer clusters per
+// pixel in its one pass. Measured by bench/preview_stages.cpp.
+struct CoarsePreview {
+  int slices = 48;
+  int clustersPerPass = 4;
+  size_t maxPixels = 400000;  // larger windows get it at half their width and height, upscaled
+};
+// Its divisor of the window's width and height: 1, or 2 past CoarsePreview::maxPixels.
+inline int coarsePreviewDivisor(int width, int height, const CoarsePreview& coarse = {}) {
+  return size_t(width) * size_t(height) > coarse.maxPixels ? 2 : 1;
+}
+PreviewSettings coarsePreviewSettings(const PreviewSettings& full, size_t pixels, const CoarsePreview& coarse = {});
 
 }  // namespace vpl

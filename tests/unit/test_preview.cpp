@@ -3,8 +3,10 @@
 #include <cmath>
 #include <filesystem>
 #include "render/core/color.h"
+#include "render/film/film.h"
 #include "render/film/image_metrics.h"
 #include "render/session/render_job.h"
+#include "render/session/tile_renderer.h"
 #include "render/scene/gltf_loader.h"
 #include "render/vpl/vpl_preview.h"
 #include "render/vpl/vpl_tracer.h"
@@ -89,6 +91,36 @@ TEST(Preview, FirstPassesConvergeToTheManyPassLimit) {
     std::printf("%s: median error against the next 2048 passes after 16 passes %.4g, after 256 %.4g (ratio %.1f, ideal 14.3)\n",
                 scene.c_str(), after16, after256, after16 / after256);
     EXPECT_GT(after16 / after256, 5.0) << scene;
+  }
+}
+
+// The viewer's first preview (coarsePreviewSettings: few slices, few clusters per pixel) shows the same
+// light as the full one: the two images' means agree, after one coarse pass and after many.
+TEST(Preview, CoarseFirstPreviewMatchesTheFullOne) {
+  for (const std::string scene : {"cornell_box.gltf", "two_rooms.gltf"}) {
+    const RenderScene rs(loadGltf(test::sourceDir() + "/scenes/" + scene));
+    const Camera camera(defaultCamera(rs.data()), 160, 120);
+    PreviewSettings full;
+    full.vpl.count = 4096;
+    full.slices.maxSliceSize = 64;  // many slices at this small size, as a window has
+    const auto vpls = std::make_shared<VplSet>(traceVpls(rs, full.vpl));
+    const PreviewSettings coarse = coarsePreviewSettings(full, 160 * 120);
+    const VplField fullField = buildVplField(rs, camera, vpls, full), coarseField = buildVplField(rs, camera, vpls, coarse);
+    EXPECT_LE(coarseField.tree.slices.size(), size_t(2 * CoarsePreview{}.slices)) << scene;  // median splits: up to 2x
+    EXPECT_LT(coarseField.tree.slices.size(), fullField.tree.slices.size()) << scene;
+    const TileRenderer fullRenderer(camera, 3, previewShader(rs, fullField, full));
+    const TileRenderer coarseRenderer(camera, 3, previewShader(rs, coarseField, coarse));
+    Film fullFilm(160, 120), coarseFilm(160, 120);
+    for (uint64_t pass = 0; pass < 64; ++pass) fullRenderer.renderPass(fullFilm, pass);
+    coarseRenderer.renderPass(coarseFilm, 0);
+    const Image onePass = coarseFilm.resolve();
+    for (uint64_t pass = 1; pass < 64; ++pass) coarseRenderer.renderPass(coarseFilm, pass);
+    const double first = relativeBias(onePass, fullFilm.resolve()), many = relativeBias(coarseFilm.resolve(), fullFilm.resolve());
+    std::printf("%s: coarse preview against the full one (64 passes): mean %+.4f after 1 pass, %+.4f after 64\n", scene.c_str(),
+                first, many);
+    EXPECT_TRUE(allFinite(onePass)) << scene;
+    EXPECT_LT(std::abs(first), 0.10) << scene;
+    EXPECT_LT(std::abs(many), 0.03) << scene;
   }
 }
 
