@@ -23,36 +23,46 @@ std::string LightSliceSettings::validate() const {
 namespace {
 
 // Light matrix columns restricted to some rows, stored column by column with their norms and unit
-// vectors, so the clustering's inner loops read contiguous memory.
+// vectors, so the clustering's inner loops read contiguous memory. Each column is padded with zeros
+// to a multiple of four rows: the dot products then run four lanes at a time (a float reduction of
+// unknown length is not vectorized without reassociation).
 class Columns {
  public:
-  Columns(std::span<const float* const> rows, uint32_t n) : dim_(rows.size()), norms_(n), unit_(size_t(n) * rows.size()) {
+  Columns(std::span<const float* const> rows, uint32_t n)
+      : stride_((rows.size() + 3) / 4 * 4), norms_(n), unit_(size_t(n) * stride_, 0.0f) {
     for (uint32_t j = 0; j < n; ++j) {
       float s = 0.0f;
       for (const float* r : rows) s += r[j] * r[j];
       norms_[j] = std::sqrt(s);
       const float inv = norms_[j] > 0.0f ? 1.0f / norms_[j] : 0.0f;
-      for (size_t r = 0; r < dim_; ++r) unit_[size_t(j) * dim_ + r] = rows[r][j] * inv;
+      for (size_t r = 0; r < rows.size(); ++r) unit_[size_t(j) * stride_ + r] = rows[r][j] * inv;
     }
   }
+  size_t stride() const { return stride_; }
   float norm(uint32_t vpl) const { return norms_[vpl]; }
+  const float* unit(uint32_t vpl) const { return &unit_[size_t(vpl) * stride_]; }
+  float dot(const float* a, const float* b) const {
+    float lane[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+    for (size_t r = 0; r < stride_; r += 4)
+      for (size_t l = 0; l < 4; ++l) lane[l] += a[r + l] * b[r + l];
+    return (lane[0] + lane[1]) + (lane[2] + lane[3]);
+  }
   // Cosine between two columns (1 when either is zero, so zero columns never drive a split).
   float cosine(uint32_t a, uint32_t b) const {
     if (norms_[a] <= 0.0f || norms_[b] <= 0.0f) return 1.0f;
-    const float *ua = &unit_[size_t(a) * dim_], *ub = &unit_[size_t(b) * dim_];
-    float d = 0.0f;
-    for (size_t r = 0; r < dim_; ++r) d += ua[r] * ub[r];
-    return d;
+    return dot(unit(a), unit(b));
   }
   // Matrix row-column sampling cost (Hašan et al. 2007, §4.1): sum over member pairs of
-  // |x_i||x_j| |x_i/|x_i| - x_j/|x_j||^2 = 2 (sum |x_i|)^2 - 2 |sum x_i|^2.
-  double cost(std::span<const uint32_t> members) const {
-    std::vector<double> sum(dim_, 0.0);
+  // |x_i||x_j| |x_i/|x_i| - x_j/|x_j||^2 = 2 (sum |x_i|)^2 - 2 |sum x_i|^2. `sum` is scratch space.
+  double cost(std::span<const uint32_t> members, std::vector<double>& sum) const {
+    sum.assign(stride_, 0.0);
     double sumNorm = 0.0;
     for (uint32_t j : members) {
-      sumNorm += norms_[j];
-      const float* u = &unit_[size_t(j) * dim_];
-      for (size_t r = 0; r < dim_; ++r) sum[r] += double(u[r]) * norms_[j];
+      const double w = norms_[j];
+      if (w <= 0.0) continue;
+      sumNorm += w;
+      const float* u = unit(j);
+      for (size_t r = 0; r < stride_; ++r) sum[r] += double(u[r]) * w;
     }
     double sum2 = 0.0;
     for (double v : sum) sum2 += v * v;
@@ -60,7 +70,7 @@ class Columns {
   }
 
  private:
-  size_t dim_;
+  size_t stride_;
   std::vector<float> norms_, unit_;
 };
 
@@ -78,23 +88,38 @@ struct VplFigures {
   }
 };
 
+// Scratch space of one slice's refinement, reused across its splits.
+struct SplitScratch {
+  std::vector<float> norms;
+  std::vector<uint32_t> rest;
+  std::vector<double> sum;
+};
+
 // Two-way split of a cluster: pick two far-apart members in normalised column space and give every
 // member to the nearer one; members that are zero on these rows go by VPL position.
-bool splitCluster(const Columns& cols, std::span<const glm::vec3> position, std::vector<uint32_t>& members,
-                  std::vector<uint32_t>& left, std::vector<uint32_t>& right) {
+bool splitCluster(const Columns& cols, std::span<const glm::vec3> position, const std::vector<uint32_t>& members,
+                  std::vector<uint32_t>& left, std::vector<uint32_t>& right, SplitScratch& scratch) {
   if (members.size() < 2) return false;
-  std::vector<float> norms(members.size());
+  std::vector<float>& norms = scratch.norms;
+  norms.resize(members.size());
   size_t pivot = 0;
   for (size_t i = 0; i < members.size(); ++i) {
     norms[i] = cols.norm(members[i]);
     if (norms[i] > norms[pivot]) pivot = i;
   }
   if (norms[pivot] <= 0.0f) pivot = 0;
+  // The member least aligned with `from` (cosine 1 for zero columns, as Columns::cosine has it),
+  // among at most kCandidates evenly strided members: the two poles need only be far apart, and a
+  // full search on a cluster of thousands was most of the refinement's time.
+  constexpr size_t kCandidates = 64;
+  const size_t step = std::max<size_t>(1, members.size() / kCandidates);
   auto farthest = [&](size_t from) {
     size_t best = from;
     float bestCos = 2.0f;
-    for (size_t i = 0; i < members.size(); ++i) {
-      const float c = cols.cosine(members[from], members[i]);
+    if (norms[from] <= 0.0f) return best;
+    const float* u = cols.unit(members[from]);
+    for (size_t i = 0; i < members.size(); i += step) {
+      const float c = norms[i] > 0.0f ? cols.dot(u, cols.unit(members[i])) : 1.0f;
       if (c < bestCos) {
         bestCos = c;
         best = i;
@@ -106,15 +131,16 @@ bool splitCluster(const Columns& cols, std::span<const glm::vec3> position, std:
   left.clear();
   right.clear();
   if (b != c && norms[b] > 0.0f && norms[c] > 0.0f) {
+    const float *ub = cols.unit(members[b]), *uc = cols.unit(members[c]);
     for (size_t i = 0; i < members.size(); ++i) {
       if (norms[i] <= 0.0f) continue;
-      const float cb = cols.cosine(members[i], members[b]);
-      const float cc = cols.cosine(members[i], members[c]);
-      (cb >= cc ? left : right).push_back(members[i]);
+      const float* u = cols.unit(members[i]);
+      (cols.dot(u, ub) >= cols.dot(u, uc) ? left : right).push_back(members[i]);
     }
   }
   // Zero columns, or columns all alike: split by position along the longest axis of the members.
-  std::vector<uint32_t> rest;
+  std::vector<uint32_t>& rest = scratch.rest;
+  rest.clear();
   for (size_t i = 0; i < members.size(); ++i)
     if (norms[i] <= 0.0f || left.empty() || right.empty()) rest.push_back(members[i]);
   if (left.empty() || right.empty()) {
@@ -223,17 +249,36 @@ LightSliceResult clusterLightSlice(std::span<const Vpl> vpls, std::span<const Ga
   std::vector<std::vector<uint32_t>> globalClusters(seeds.size());
   for (uint32_t j = 0; j < n; ++j) globalClusters[globalOf[j]].push_back(j);
   std::erase_if(globalClusters, [](const auto& c) { return c.empty(); });
+  // Oversized global clusters (typically VPLs that no reduced row sees, gathered by position around a
+  // few seeds) are halved in space until each holds at most four times the mean: every slice would
+  // otherwise split them again, and their size set the refinement's cost.
+  const size_t largest = std::max<size_t>(2, 4 * size_t(n) / size_t(std::max(1, settings.globalClusters)));
+  for (size_t c = 0; c < globalClusters.size(); ++c) {
+    while (globalClusters[c].size() > largest) {
+      std::vector<uint32_t>& members = globalClusters[c];
+      glm::vec3 lo(INFINITY), hi(-INFINITY);
+      for (uint32_t j : members) {
+        lo = glm::min(lo, figures.position[j]);
+        hi = glm::max(hi, figures.position[j]);
+      }
+      const glm::vec3 ext = hi - lo;
+      const int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
+      const auto mid = members.begin() + std::ptrdiff_t(members.size() / 2);
+      std::nth_element(members.begin(), mid, members.end(),
+                       [&](uint32_t a, uint32_t b) { return figures.position[a][axis] < figures.position[b][axis]; });
+      std::vector<uint32_t> upper(mid, members.end());
+      members.erase(mid, members.end());
+      std::sort(members.begin(), members.end());  // index order: the per-slice loops walk memory forwards
+      std::sort(upper.begin(), upper.end());
+      globalClusters.push_back(std::move(upper));
+    }
+  }
   result.globalClusterCount = uint32_t(globalClusters.size());
   result.globalSeconds = stopwatch.lap();
 
   // 3. Per-slice refinement (LightSlice §4.2) on the slice's own row (its representative, unoccluded:
   //    one cheap evaluation per VPL) and the reduced rows nearest it (6D distance, with visibility).
-  const float scale = tree.normalScale;
-  auto embedDistance = [&](uint32_t a, uint32_t b) {
-    const GatherPoint &p = points[a], &q = points[b];
-    const glm::vec3 dp = p.position - q.position, dn = (p.normal - q.normal) * scale;
-    return glm::dot(dp, dp) + glm::dot(dn, dn);
-  };
+  auto embedDistance = [&](uint32_t a, uint32_t b) { return embeddedDistance2(points[a], points[b], tree.normalScale); };
   const uint32_t k = std::min<uint32_t>(uint32_t(settings.refinementRows), rowCount);
   tbb::parallel_for(uint32_t(0), sliceCount, [&](uint32_t s) {
     if (cancelled()) return;
@@ -242,7 +287,7 @@ LightSliceResult clusterLightSlice(std::span<const Vpl> vpls, std::span<const Ga
     for (uint32_t r = 0; r < rowCount; ++r) byDistance[r] = {embedDistance(rep, tree.slices[rowSlice[r]].representative), r};
     std::partial_sort(byDistance.begin(), byDistance.begin() + k, byDistance.end());
     std::vector<float> ownRow(n);
-    for (uint32_t j = 0; j < n; ++j) ownRow[j] = transport.contribution(s, j, false);
+    transport.unoccludedRow(s, ownRow);
     std::vector<const float*> localRows = {ownRow.data()};
     for (uint32_t i = 0; i < k; ++i) localRows.push_back(&matrix[size_t(byDistance[i].second) * n]);
     const Columns local(localRows, n);
@@ -253,18 +298,19 @@ LightSliceResult clusterLightSlice(std::span<const Vpl> vpls, std::span<const Ga
       bool operator<(const Entry& o) const { return cost < o.cost || (cost == o.cost && index > o.index); }
     };
     std::vector<std::vector<uint32_t>> clusters = globalClusters;
+    SplitScratch scratch;
     std::priority_queue<Entry> queue;
-    for (uint32_t c = 0; c < clusters.size(); ++c) queue.push({local.cost(clusters[c]), c});
+    for (uint32_t c = 0; c < clusters.size(); ++c) queue.push({local.cost(clusters[c], scratch.sum), c});
     std::vector<uint32_t> left, right;
     while (int(clusters.size()) < settings.clusterBudget && !queue.empty()) {
       const Entry top = queue.top();
       queue.pop();
       if (top.cost <= 0.0 && clusters[top.index].size() < 2) continue;
-      if (!splitCluster(local, figures.position, clusters[top.index], left, right)) continue;
-      clusters[top.index] = left;
+      if (!splitCluster(local, figures.position, clusters[top.index], left, right, scratch)) continue;
+      std::swap(clusters[top.index], left);
       clusters.push_back(right);
-      queue.push({local.cost(clusters[top.index]), top.index});
-      queue.push({local.cost(clusters.back()), uint32_t(clusters.size() - 1)});
+      queue.push({local.cost(clusters[top.index], scratch.sum), top.index});
+      queue.push({local.cost(clusters.back(), scratch.sum), uint32_t(clusters.size() - 1)});
     }
 
     // Representatives by power, and their estimated contribution (with visibility) at this slice.
@@ -274,23 +320,33 @@ LightSliceResult clusterLightSlice(std::span<const Vpl> vpls, std::span<const Ga
     uint64_t evals = n;
     for (size_t c = 0; c < clusters.size(); ++c) {
       VplCluster& cl = out.clusters[c];
-      std::vector<float> power(clusters[c].size());
-      for (size_t i = 0; i < clusters[c].size(); ++i) {
-        const uint32_t j = clusters[c][i];
+      const std::vector<uint32_t>& members = clusters[c];
+      double total = 0.0;
+      for (uint32_t j : members) {
         cl.totalFlux += figures.flux[j];
-        power[i] = figures.power[j];
-        cl.totalPower += power[i];
+        total += std::max(0.0f, figures.power[j]);
       }
-      const Distribution1D pick(power);
-      cl.representative = pick.empty() ? clusters[c][0] : clusters[c][pick.sample(rng.uniform())];
-      if (cl.totalPower > 0.0f) {
+      cl.totalPower = float(total);
+      // The representative by power: the member whose share of the running sum holds u x total.
+      cl.representative = members[0];
+      const float u = rng.uniform();
+      if (total > 0.0) {
+        const double target = double(u) * total;
+        double running = 0.0;
+        for (uint32_t j : members) {
+          const float p = std::max(0.0f, figures.power[j]);
+          if (p <= 0.0f) continue;
+          cl.representative = j;
+          running += p;
+          if (running > target) break;
+        }
         double spread2 = 0.0;
         const glm::vec3 centre = figures.position[cl.representative];
-        for (size_t i = 0; i < clusters[c].size(); ++i) {
-          const glm::vec3 d = figures.position[clusters[c][i]] - centre;
-          spread2 += double(power[i]) * glm::dot(d, d);
+        for (uint32_t j : members) {
+          const glm::vec3 d = figures.position[j] - centre;
+          spread2 += double(std::max(0.0f, figures.power[j])) * glm::dot(d, d);
         }
-        cl.spread = float(std::sqrt(spread2 / cl.totalPower));
+        cl.spread = float(std::sqrt(spread2 / total));
       }
       const float repPower = figures.power[cl.representative];
       cl.estimate = repPower > 0.0f ? transport.contribution(s, cl.representative, true) * (cl.totalPower / repPower) : 0.0f;

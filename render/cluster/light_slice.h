@@ -38,6 +38,13 @@ class LightTransport {
   // Luminance that VPL `vpl` sends towards slice `slice`'s representative (non-negative, finite);
   // with visibility when `visible` is true, else unoccluded.
   virtual float contribution(uint32_t slice, uint32_t vpl, bool visible) const = 0;
+  // Every VPL's contribution at slice `slice` without visibility, into out[0, vpl count): the row
+  // that the slice's refinement compares columns on. Only the row's shape matters there, so a
+  // transport may approximate it (for instance without the BSDFs' glossy lobes) when exact rows cost
+  // more than the clustering gains; by default, exact.
+  virtual void unoccludedRow(uint32_t slice, std::span<float> out) const {
+    for (uint32_t j = 0; j < out.size(); ++j) out[j] = contribution(slice, j, false);
+  }
 };
 
 struct VplCluster {

@@ -67,7 +67,9 @@ struct Builder {
         best = order[i];
       }
     }
-    slices.push_back({begin, end, best});
+    double spread = 0.0;
+    for (uint32_t i = begin; i < end; ++i) spread += distance2(p[order[i]], p[best]);
+    slices.push_back({begin, end, best, float(spread / double(end - begin))});
   }
 };
 

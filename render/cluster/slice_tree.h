@@ -30,7 +30,14 @@ struct SliceSettings {
 struct Slice {
   uint32_t begin = 0, end = 0;   // range in SliceTree::order
   uint32_t representative = 0;   // a member gather point: the one nearest the slice's 6D centroid
+  float radius2 = 0.0f;          // mean squared 6D distance of the members from the representative
 };
+
+// Squared distance of two gather points in the 6D embedding (position, normal x normalScale).
+inline float embeddedDistance2(const GatherPoint& a, const GatherPoint& b, float normalScale) {
+  const glm::vec3 dp = a.position - b.position, dn = (a.normal - b.normal) * normalScale;
+  return glm::dot(dp, dp) + glm::dot(dn, dn);
+}
 
 struct SliceTree {
   std::vector<uint32_t> order;       // gather point indices grouped by slice

@@ -43,7 +43,9 @@ class PixelSampler {
   explicit PixelSampler(Rng& rng) : independent_(&rng) {}
 
   glm::vec2 cameraJitter() { return get2D(kCameraSlot); }
-  float previewClusters() { return get1D(kPreviewClusterSlot); }
+  // The preview's two choices per pass: x, the offset of its systematic cluster picks; y, the slice
+  // whose clusters it uses (its own or a neighbour, so that slices blend across their borders).
+  glm::vec2 previewChoices() { return get2D(kPreviewClusterSlot); }
 
   // A slot read in 1D is the first coordinate of its 2D point.
   float get1D(int vertex, VertexDimension d) {

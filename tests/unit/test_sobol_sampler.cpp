@@ -156,14 +156,16 @@ TEST(PixelSampler, FirstSamplesOfEverySlotAreStratified) {
     for (uint64_t pixel : {0ull, 1ull, 4242ull, 65535ull}) {
       for (const Slot2& slot : kSlots2D) {
         std::vector<glm::vec2> points;
-        std::vector<glm::vec2> camera;
+        std::vector<glm::vec2> camera, preview;
         for (int m = 0; m <= 10; ++m) {
           while (points.size() < size_t(1) << m) {
             points.push_back(value2D(seed, pixel, points.size(), slot));
             camera.push_back(PixelSampler(seed, pixel, camera.size()).cameraJitter());
+            preview.push_back(PixelSampler(seed, pixel, preview.size()).previewChoices());
           }
           ASSERT_EQ(netDefect(points, m), "") << "vertex " << slot.vertex << " dimension " << int(slot.d) << ", pixel " << pixel;
           ASSERT_EQ(netDefect(camera, m), "") << "camera jitter, pixel " << pixel;
+          ASSERT_EQ(netDefect(preview, m), "") << "preview choices, pixel " << pixel;
         }
       }
       for (const Slot1& slot : kSlots1D) {
@@ -171,7 +173,7 @@ TEST(PixelSampler, FirstSamplesOfEverySlotAreStratified) {
         for (int m = 0; m <= 12; ++m) {
           while (values.size() < size_t(1) << m) {
             values.push_back(value1D(seed, pixel, values.size(), slot));
-            clusters.push_back(PixelSampler(seed, pixel, clusters.size()).previewClusters());
+            clusters.push_back(PixelSampler(seed, pixel, clusters.size()).previewChoices().x);
           }
           ASSERT_EQ(strataDefect(values, m), "") << "vertex " << slot.vertex << " dimension " << int(slot.d) << ", pixel " << pixel;
           ASSERT_EQ(strataDefect(clusters, m), "") << "preview clusters, pixel " << pixel;
