@@ -2,8 +2,8 @@
 // stage of the full preview as the viewer builds it (VPLs, gather points, slice tree, LightSlice's
 // reduced matrix, global clustering and per-slice refinement, the guide, one preview pass), the same
 // for the coarse first preview (coarsePreviewSettings; half size past CoarsePreview::maxPixels), and
-// the viewer session's own figure: from a restart to its first preview image, at opening (VPLs
-// traced) and after a camera move (VPLs kept).
+// the viewer session's own figures: from a restart to its first preview image, at opening (VPLs
+// traced) and after a camera move (VPLs kept), and to the start of path-traced refinement (mis).
 // Prints one Markdown table row per scene and size; median of `runs` runs per figure.
 // Usage: preview_stages [--threads N] [--runs N] [--sizes 320x240,640x360,1280x720] SCENE...
 #include <algorithm>
@@ -30,7 +30,7 @@ namespace {
 struct Figures {
   double vpl = 0, gather = 0, slices = 0, matrix = 0, global = 0, refine = 0, guide = 0, pass = 0;
   double coarseField = 0, coarsePass = 0;
-  double sessionOpen = 0, sessionMove = 0;
+  double sessionOpen = 0, sessionMove = 0, refineStart = 0;
   size_t sliceCount = 0, coarseSlices = 0;
 };
 
@@ -60,6 +60,18 @@ double sessionFirstPreview(const std::shared_ptr<const RenderScene>& scene, int 
   session.setCamera(camera);
   while (session.stats().restarts == restarts) std::this_thread::sleep_for(std::chrono::microseconds(200));
   return waitPreview();
+}
+
+// Opening -> the first path-traced pass begins, in the default (guided) mode.
+double sessionRefineStart(const std::shared_ptr<const RenderScene>& scene, int w, int h, int threads) {
+  SessionSettings settings;
+  settings.width = w;
+  settings.height = h;
+  settings.threads = threads;
+  ProgressiveSession session(scene, defaultCamera(scene->data()), settings);
+  for (int i = 0; i < 120000 && session.stats().refineStartSeconds == 0.0; ++i)
+    std::this_thread::sleep_for(std::chrono::microseconds(500));
+  return session.stats().refineStartSeconds;
 }
 
 Figures measure(const std::shared_ptr<const RenderScene>& scene, int w, int h, int threads) {
@@ -97,6 +109,7 @@ Figures measure(const std::shared_ptr<const RenderScene>& scene, int w, int h, i
 
   f.sessionOpen = sessionFirstPreview(scene, w, h, threads, false);
   f.sessionMove = sessionFirstPreview(scene, w, h, threads, true);
+  f.refineStart = sessionRefineStart(scene, w, h, threads);
   return f;
 }
 
@@ -129,11 +142,11 @@ int main(int argc, char** argv) {
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
   std::printf("Seconds, %d threads, median of %d runs. Full: the preview as the viewer builds it after the coarse pass; "
               "first preview: VPLs + coarse field + its pass; session: restart -> first preview image (incl. the quick "
-              "stage), at opening / after a camera move.\n\n",
+              "stage), at opening / after a camera move; refine: opening -> the first path-traced pass (mis).\n\n",
               threads, runs);
   std::printf("| scene | size | VPLs | gather | slices | matrix | global | refine | guide | pass | full preview | "
-              "coarse field | coarse pass | **first preview** | session open | session move |\n");
-  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+              "coarse field | coarse pass | **first preview** | session open | session move | refine |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   try {
     for (const std::string& path : scenes) {
       const auto scene = std::make_shared<const RenderScene>(loadGltf(path));
@@ -151,11 +164,12 @@ int main(int argc, char** argv) {
                                    med(&Figures::matrix) + med(&Figures::global) + med(&Figures::refine) + med(&Figures::pass);
         const double first = med(&Figures::vpl) + med(&Figures::coarseField) + med(&Figures::coarsePass);
         std::printf("| %s | %dx%d (%zu / %zu slices) | %.3f | %.3f | %.3f | %.3f | %.3f | %.3f | %.3f | %.3f | %.3f | %.3f | "
-                    "%.3f | **%.3f** | %.3f | %.3f |\n",
+                    "%.3f | **%.3f** | %.3f | %.3f | %.3f |\n",
                     name.c_str(), w, h, all[0].sliceCount, all[0].coarseSlices, med(&Figures::vpl), med(&Figures::gather),
                     med(&Figures::slices), med(&Figures::matrix), med(&Figures::global), med(&Figures::refine),
                     med(&Figures::guide), med(&Figures::pass), fullPreview, med(&Figures::coarseField),
-                    med(&Figures::coarsePass), first, med(&Figures::sessionOpen), med(&Figures::sessionMove));
+                    med(&Figures::coarsePass), first, med(&Figures::sessionOpen), med(&Figures::sessionMove),
+                    med(&Figures::refineStart));
         std::fflush(stdout);
       }
     }

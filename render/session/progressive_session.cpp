@@ -174,7 +174,7 @@ void ProgressiveSession::controllerLoop() {
       state.renderSeconds = seconds;
       std::lock_guard lock(mutex_);
       ++stats_.restarts;
-      stats_.firstPreviewSeconds = 0.0;
+      stats_.firstPreviewSeconds = stats_.refineStartSeconds = 0.0;
     }
     state.key = request;
     arena.execute([&] { runUntilChanged(state, request); });
@@ -255,8 +255,15 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
     stats_.vpls = vpls_->vpls.size();
   }
   if (cancelled()) return;
-  const PixelShaderFactory previewShading = previewShader(scene, *state.field, settings_.preview);
-  const int previewTarget = request.mode == SamplingMode::Preview ? settings_.maxSpp : settings_.previewPasses;
+  // In a refining mode the preview only bridges the time until the path-traced film takes over: its
+  // passes draw fewer clusters per pixel and stop after previewSeconds (one at least), so that
+  // refinement starts soon even where a full preview pass takes seconds (a large view of a large scene).
+  const bool refining = request.mode != SamplingMode::Preview;
+  PreviewSettings previewSettings = settings_.preview;
+  if (refining) previewSettings.clustersPerPass = std::min(previewSettings.clustersPerPass, CoarsePreview{}.clustersPerPass);
+  const PixelShaderFactory previewShading = previewShader(scene, *state.field, previewSettings);
+  const int previewTarget = refining ? settings_.previewPasses : settings_.maxSpp;
+  const auto previewStart = Clock::now();
   CameraState::ModeFilm& preview = state.preview;
   if (!preview.film) preview.film = std::make_unique<Film>(w, h);
   const TileRenderer previewRenderer(camera, settings_.seed, previewShading);
@@ -264,7 +271,8 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
     auto it = state.films.find(request.mode);
     return it == state.films.end() ? 0 : it->second.complete;
   };
-  while (preview.complete < previewTarget && modeFilmComplete() < settings_.handoverSpp) {
+  while (preview.complete < previewTarget && modeFilmComplete() < settings_.handoverSpp &&
+         !(refining && preview.complete > 0 && secondsSince(previewStart) >= settings_.previewSeconds)) {
     previewRenderer.renderPass(*preview.film, preview.nextPass++, &cancel_);
     if (cancelled()) return;
     ++preview.complete;
@@ -295,6 +303,10 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
   // A mode flipped back to shows its own film at once, if it has passed the handover.
   if (mine.complete >= settings_.handoverSpp)
     publish(mine.film->resolve(), SessionStage::Refine, mine.complete, mine.film->resolveVariance());
+  {
+    std::lock_guard lock(mutex_);
+    if (stats_.refineStartSeconds == 0.0) stats_.refineStartSeconds = secondsSince(state.restart);
+  }
   while (mine.complete < settings_.maxSpp) {
     const auto t = Clock::now();
     const PassStats pass = renderer.renderPass(*mine.film, mine.nextPass++, &cancel_);

@@ -4,7 +4,8 @@
 //   1. quick     a 1-spp BSDF pass at a quarter of the resolution: a whole new frame at once
 //   2. preview   first one pass of a coarse preview (few slices, few clusters per pixel: fast), then
 //                this camera's gather points, slices and LightSlice clusters in full (the VPLs themselves
-//                are traced once per scene and kept), then `previewPasses` preview passes
+//                are traced once per scene and kept), then preview passes (in a refining mode at most
+//                `previewPasses` and `previewSeconds`, with fewer clusters per pixel)
 //   3. refine    the guide (guided modes), then path-traced passes into the mode's own film, until
 //                `maxSpp`
 // The shown image is the newest stage with something to show; the path-traced film takes over once
@@ -34,7 +35,8 @@ struct SessionSettings {
   int width = 640, height = 480;
   uint64_t seed = 1;
   int threads = 0;           // render workers; 0: every core
-  int previewPasses = 4;
+  int previewPasses = 4;      // refining modes: preview passes at most (fewer clusters per pixel than `preview` mode)
+  double previewSeconds = 1.0;  // refining modes: ... and for this long at most, one pass at least
   int handoverSpp = 16;      // path-traced samples before the display leaves the preview
   int maxSpp = 1 << 16;      // the controller idles after this many path-traced samples
   int maxSlices = 384;       // slices (cache points) per view at most; 0: preview.slices alone decides
@@ -54,6 +56,7 @@ struct SessionStats {
   double sinceRestart = 0.0;     // seconds since the last restart
   double firstFrameSeconds = 0.0;  // restart -> first full frame (the quick pass)
   double firstPreviewSeconds = 0.0;  // restart -> first preview image (coarse or full); 0 until then
+  double refineStartSeconds = 0.0;   // restart -> the first path-traced pass begins; 0 until then
   double samplesPerSecond = 0.0, raysPerSecond = 0.0;  // of the path-traced passes so far
   double vplSeconds = 0.0, clusterSeconds = 0.0, guideSeconds = 0.0;
   size_t vpls = 0, cachePoints = 0;
