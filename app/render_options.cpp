@@ -6,6 +6,7 @@
 #include <sstream>
 #include <thread>
 #include "render/core/error.h"
+#include "render/integrator/sampling_mode.h"
 
 namespace vpl::app {
 
@@ -67,7 +68,8 @@ void RenderOptions::addCommonTo(CLI::App& command) {
   command.add_option("--sky", sky, "uniform sky radiance R,G,B; 0 turns it off (default: on only without lights)");
   command.add_option("--exposure", exposure, "PNG exposure in stops");
   command.add_option("--vpls", preview.vpl.count, "number of VPLs")->check(CLI::Range(0, 50'000'000));
-  command.add_option("--slice-size", preview.slices.maxSliceSize, "largest slice, in gather points")->check(CLI::Range(1, 1 << 24));
+  command.add_option("--slice-size", sliceSize, "largest slice, in gather points (default: 256 preview, 512 guided modes)")
+      ->check(CLI::Range(1, 1 << 24));
   command.add_option("--normal-scale", preview.slices.normalScale, "6D kd-tree normal weight (0: scene diagonal / 16)")
       ->check(CLI::NonNegativeNumber);
   command.add_option("--global-clusters", preview.clustering.globalClusters, "LightSlice global clusters")->check(CLI::Range(1, 1 << 20));
@@ -106,6 +108,10 @@ RenderJobSettings RenderOptions::toSettings() const {
   s.tracer.rrStartDepth = rrStart;
   s.tracer.roulette = roulette == "sqrt" ? RouletteRule::Sqrt : RouletteRule::Throughput;
   s.preview = preview;
+  if (sliceSize > 0)
+    s.preview.slices.maxSliceSize = sliceSize;
+  else if (isGuided(s.mode))
+    s.preview.slices.maxSliceSize = kGuidedSliceSize;
   s.guide = guide;
   s.guide.coneAngle = coneDegrees * 3.14159265f / 180.0f;
   s.guide.perturbationAngle = perturbDegrees * 3.14159265f / 180.0f;

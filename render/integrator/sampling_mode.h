@@ -19,6 +19,11 @@ inline const char* modeName(SamplingMode m) {
   return "?";
 }
 
+// The modes that path trace with the VPL guide.
+inline bool isGuided(SamplingMode m) {
+  return m == SamplingMode::Metropolis || m == SamplingMode::Mis || m == SamplingMode::Mixture;
+}
+
 inline std::optional<SamplingMode> parseMode(std::string_view name) {
   for (SamplingMode m : {SamplingMode::Brdf, SamplingMode::Metropolis, SamplingMode::Mis, SamplingMode::Mixture,
                          SamplingMode::Preview})

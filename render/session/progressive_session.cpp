@@ -29,8 +29,6 @@ Image upscaleNearest(const Image& small, int width, int height) {
   return out;
 }
 
-bool isGuided(SamplingMode m) { return m == SamplingMode::Metropolis || m == SamplingMode::Mis || m == SamplingMode::Mixture; }
-
 }  // namespace
 
 const char* stageName(SessionStage stage) {
