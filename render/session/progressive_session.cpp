@@ -34,6 +34,7 @@ Image upscaleNearest(const Image& small, int width, int height) {
 const char* stageName(SessionStage stage) {
   switch (stage) {
     case SessionStage::Quick: return "quick";
+    case SessionStage::Coarse: return "coarse";
     case SessionStage::Preview: return "preview";
     case SessionStage::Refine: return "refine";
     case SessionStage::Done: return "done";
@@ -241,7 +242,7 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
       Film film(coarseCamera.width(), coarseCamera.height());
       TileRenderer(coarseCamera, settings_.seed, previewShader(scene, coarseField, coarse)).renderPass(film, 0, &cancel_);
       if (cancelled()) return;
-      publish(divisor > 1 ? upscaleNearest(film.resolve(), w, h) : film.resolve(), SessionStage::Preview, 1);
+      publish(divisor > 1 ? upscaleNearest(film.resolve(), w, h) : film.resolve(), SessionStage::Coarse, 1);
       notePreview();
     }
     auto field = std::make_unique<VplField>(buildVplField(scene, camera, vpls_, preview, &cancel_));

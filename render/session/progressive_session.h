@@ -46,7 +46,7 @@ struct SessionSettings {
   GuideSettings guide;
 };
 
-enum class SessionStage { Quick, Preview, Refine, Done };
+enum class SessionStage { Quick, Coarse, Preview, Refine, Done };  // Coarse: the coarse preview pass
 const char* stageName(SessionStage stage);
 
 struct SessionStats {

@@ -19,9 +19,10 @@ timeout 60 xvfb-run -a "$exe" "$tmp/broken.gltf" --screenshot "$tmp/none.png" 2>
 rc=$?
 [ $rc = 2 ] && [ "$(grep -c . "$tmp/err")" = 1 ] || { echo "FAIL: broken scene gave exit $rc: $(cat "$tmp/err")"; exit 1; }
 [ ! -s "$tmp/none.png" ] || { echo "FAIL: a window was shown for a broken scene"; exit 1; }
-# The window must show at least the full-size preview, not the quarter-size quick passes that come
-# first: a slow build (AddressSanitizer on a loaded machine measured more than 3 s to cluster the
-# VPLs) gets longer, and the last stats line says which stage the screenshot saw.
+# The window must show at least the full-size preview, not the quarter-size quick passes or the one
+# coarse preview pass that come first (the coarse pass alone measured 6 % darker than the capture,
+# one block 28 % apart): a slow build (AddressSanitizer on a loaded machine measured more than 3 s to
+# cluster the VPLs) gets longer, and the last stats line says which stage the screenshot saw.
 for after in 3 12 40; do
   rm -f "$tmp/window.png" "$tmp/stats.txt"
   timeout $((after + 120)) xvfb-run -a -s "-screen 0 640x480x24" "$exe" "$scene" --width 320 --height 240 --threads 2 \
@@ -31,10 +32,10 @@ for after in 3 12 40; do
   [ $rc = 0 ] || { echo "FAIL: the viewer exited with $rc"; exit 1; }
   [ -s "$tmp/window.png" ] || { echo "FAIL: no screenshot"; exit 1; }
   stage=$(tail -n 1 "$tmp/stats.txt" | sed -n 's/.* stage \([a-z]*\) .*/\1/p')
-  [ "$stage" = quick ] || break
-  echo "the window still showed the quick stage after $after s: waiting longer"
+  [ "$stage" = quick ] || [ "$stage" = coarse ] || break
+  echo "the window still showed the $stage stage after $after s: waiting longer"
 done
-[ "$stage" != quick ] || { echo "FAIL: the window never got past the quick stage"; exit 1; }
+[ "$stage" != quick ] && [ "$stage" != coarse ] || { echo "FAIL: the window never got past the $stage stage"; exit 1; }
 "$exe" capture "$scene" --mode brdf --spp 256 --width 320 --height 240 --out "$tmp/capture.png" >/dev/null || exit 1
 compare=$repo/tests/e2e/png_compare.py
 python3 "$compare" "$tmp/window.png" "$tmp/capture.png" 0.05 0.20 10 || exit 1
