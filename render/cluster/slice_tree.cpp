@@ -26,11 +26,9 @@ struct Builder {
   const std::vector<Point6>& p;
   std::vector<uint32_t>& order;
   std::vector<Slice>& slices;
-  std::vector<SliceNode>& nodes;
   uint32_t maxSize;
 
-  // Builds the subtree of points [begin, end) into nodes[node].
-  void split(uint32_t node, uint32_t begin, uint32_t end) {
+  void split(uint32_t begin, uint32_t end) {
     Point6 lo, hi;
     lo.fill(std::numeric_limits<float>::max());
     hi.fill(std::numeric_limits<float>::lowest());
@@ -43,39 +41,16 @@ struct Builder {
     for (int k = 1; k < 6; ++k)
       if (hi[k] - lo[k] > hi[axis] - lo[axis]) axis = k;
     if (end - begin <= maxSize) {
-      nodes[node] = {-1, 0.0f, uint32_t(slices.size())};
       leaf(begin, end);
       return;
     }
-    // Splitting at the median position (not the spatial middle) keeps the tree balanced. Points on
-    // the split value all go right, as sliceAt() sends them: walls and floors put many points on one
-    // value, and dividing those arbitrarily made sliceAt() answer slices that hold none of them.
-    // Only points identical on this axis (then on all: it is the longest) are simply divided in two.
-    uint32_t mid = begin + (end - begin) / 2;
+    // Splitting at the median position (not the spatial middle) keeps the tree balanced; identical
+    // points are simply divided in two.
+    const uint32_t mid = begin + (end - begin) / 2;
     std::nth_element(order.begin() + begin, order.begin() + mid, order.begin() + end,
                      [&](uint32_t a, uint32_t b) { return p[a][axis] < p[b][axis]; });
-    float value = p[order[mid]][axis];
-    auto below = [&](float v) {
-      return uint32_t(std::partition(order.begin() + begin, order.begin() + end, [&](uint32_t a) { return p[a][axis] < v; }) -
-                      order.begin());
-    };
-    mid = below(value);
-    if (mid == begin) {  // the median is the smallest value: split above it instead
-      float next = std::numeric_limits<float>::max();
-      for (uint32_t i = begin; i < end; ++i)
-        if (p[order[i]][axis] > value) next = std::min(next, p[order[i]][axis]);
-      if (next < std::numeric_limits<float>::max()) {
-        value = next;
-        mid = below(value);
-      } else {
-        mid = begin + (end - begin) / 2;
-      }
-    }
-    const uint32_t children = uint32_t(nodes.size());
-    nodes[node] = {axis, value, children};
-    nodes.resize(nodes.size() + 2);
-    split(children, begin, mid);
-    split(children + 1, mid, end);
+    split(begin, mid);
+    split(mid, end);
   }
 
   void leaf(uint32_t begin, uint32_t end) {
@@ -115,10 +90,7 @@ SliceTree buildSliceTree(std::span<const GatherPoint> points, const SliceSetting
   for (uint32_t i = 0; i < n; ++i) p[i] = embed(points[i], tree.normalScale);
   tree.order.resize(n);
   for (uint32_t i = 0; i < n; ++i) tree.order[i] = i;
-  if (n > 0) {
-    tree.nodes.resize(1);
-    Builder{p, tree.order, tree.slices, tree.nodes, uint32_t(settings.maxSliceSize)}.split(0, 0, n);
-  }
+  if (n > 0) Builder{p, tree.order, tree.slices, uint32_t(settings.maxSliceSize)}.split(0, n);
 
   tree.sliceOf.assign(n, 0);
   for (uint32_t s = 0; s < tree.slices.size(); ++s)
@@ -136,14 +108,6 @@ SliceTree buildSliceTree(std::span<const GatherPoint> points, const SliceSetting
     for (int k = 0; k < tree.neighbourCount; ++k) tree.neighbours[size_t(s) * tree.neighbourCount + size_t(k)] = d[size_t(k)].second;
   });
   return tree;
-}
-
-uint32_t SliceTree::sliceAt(const GatherPoint& x) const {
-  if (nodes.empty()) return 0;
-  const Point6 q = embed(x, normalScale);
-  const SliceNode* node = &nodes[0];
-  while (node->axis >= 0) node = &nodes[node->index + (q[size_t(node->axis)] < node->split ? 0u : 1u)];
-  return node->index;
 }
 
 }  // namespace vpl

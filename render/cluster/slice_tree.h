@@ -39,14 +39,6 @@ inline float embeddedDistance2(const GatherPoint& a, const GatherPoint& b, float
   return glm::dot(dp, dp) + glm::dot(dn, dn);
 }
 
-// A node of the kd-tree: an inner node splits its 6D box at `split` on `axis` (0-2 position, 3-5 the
-// scaled normal); a leaf (axis < 0) is slice `index`. Inner nodes' children are `index` and index + 1.
-struct SliceNode {
-  int axis = -1;
-  float split = 0.0f;
-  uint32_t index = 0;
-};
-
 struct SliceTree {
   std::vector<uint32_t> order;       // gather point indices grouped by slice
   std::vector<Slice> slices;
@@ -54,11 +46,6 @@ struct SliceTree {
   std::vector<uint32_t> neighbours;  // slices.size() x neighbourCount, nearest first (itself first)
   int neighbourCount = 0;
   float normalScale = 1.0f;          // the scale actually used
-  std::vector<SliceNode> nodes;      // the kd-tree; nodes[0] is the root (empty without points)
-
-  // The slice whose 6D box holds point x (any surface point, not only a gather point): the slice a
-  // jittered camera ray's hit belongs to, which its pixel's centre may not share (at an edge).
-  uint32_t sliceAt(const GatherPoint& x) const;
 
   std::span<const uint32_t> neighboursOf(uint32_t slice) const {
     return {neighbours.data() + size_t(slice) * size_t(neighbourCount), size_t(neighbourCount)};

@@ -80,22 +80,6 @@ TEST(SliceTree, LeavesAreSeparatedAlongSplitAxes) {
   EXPECT_NEAR(tree.normalScale, 7.0f / 16.0f, 1e-6f);
 }
 
-// The kd-tree's descent finds the slice of every gather point it was built from, and of any point
-// the slice whose box holds it (here: points near gather points go where those points went, unless a
-// split plane lies between them).
-TEST(SliceTree, SliceAtFindsEachPointsOwnSlice) {
-  const auto points = randomPoints(5000, 9);
-  SliceSettings settings;
-  settings.maxSliceSize = 40;
-  const SliceTree tree = buildSliceTree(points, settings, 2.0f);
-  ASSERT_GT(tree.slices.size(), 64u);
-  for (size_t i = 0; i < points.size(); ++i) ASSERT_EQ(tree.sliceAt(points[i]), tree.sliceOf[i]) << "point " << i;
-  // A point outside every box still gets a slice.
-  EXPECT_LT(tree.sliceAt({glm::vec3(1e6f), glm::vec3(0, 0, 1)}), tree.slices.size());
-  const SliceTree empty = buildSliceTree({}, settings, 2.0f);
-  EXPECT_EQ(empty.sliceAt(points[0]), 0u);
-}
-
 TEST(SliceTree, NeighboursMatchBruteForce) {
   const auto points = randomPoints(4000, 7);
   SliceSettings settings;
