@@ -38,7 +38,6 @@ class Columns {
       for (size_t r = 0; r < rows.size(); ++r) unit_[size_t(j) * stride_ + r] = rows[r][j] * inv;
     }
   }
-  size_t stride() const { return stride_; }
   float norm(uint32_t vpl) const { return norms_[vpl]; }
   const float* unit(uint32_t vpl) const { return &unit_[size_t(vpl) * stride_]; }
   float dot(const float* a, const float* b) const {
@@ -87,6 +86,22 @@ struct VplFigures {
     }
   }
 };
+
+// Orders `members` so that the first half lies below the median along the longest axis of their
+// bounding box; returns the size of that half.
+size_t halveInSpace(std::vector<uint32_t>& members, std::span<const glm::vec3> position) {
+  glm::vec3 lo(INFINITY), hi(-INFINITY);
+  for (uint32_t j : members) {
+    lo = glm::min(lo, position[j]);
+    hi = glm::max(hi, position[j]);
+  }
+  const glm::vec3 ext = hi - lo;
+  const int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
+  const size_t mid = members.size() / 2;
+  std::nth_element(members.begin(), members.begin() + std::ptrdiff_t(mid), members.end(),
+                   [&](uint32_t a, uint32_t b) { return position[a][axis] < position[b][axis]; });
+  return mid;
+}
 
 // Scratch space of one slice's refinement, reused across its splits.
 struct SplitScratch {
@@ -148,16 +163,7 @@ bool splitCluster(const Columns& cols, std::span<const glm::vec3> position, cons
     right.clear();
   }
   if (!rest.empty()) {
-    glm::vec3 lo(INFINITY), hi(-INFINITY);
-    for (uint32_t j : rest) {
-      lo = glm::min(lo, position[j]);
-      hi = glm::max(hi, position[j]);
-    }
-    const glm::vec3 ext = hi - lo;
-    const int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
-    const size_t mid = rest.size() / 2;
-    std::nth_element(rest.begin(), rest.begin() + mid, rest.end(),
-                     [&](uint32_t a, uint32_t b2) { return position[a][axis] < position[b2][axis]; });
+    const size_t mid = halveInSpace(rest, position);
     if (left.empty() && right.empty()) {
       left.assign(rest.begin(), rest.begin() + mid);
       right.assign(rest.begin() + mid, rest.end());
@@ -256,16 +262,7 @@ LightSliceResult clusterLightSlice(std::span<const Vpl> vpls, std::span<const Ga
   for (size_t c = 0; c < globalClusters.size(); ++c) {
     while (globalClusters[c].size() > largest) {
       std::vector<uint32_t>& members = globalClusters[c];
-      glm::vec3 lo(INFINITY), hi(-INFINITY);
-      for (uint32_t j : members) {
-        lo = glm::min(lo, figures.position[j]);
-        hi = glm::max(hi, figures.position[j]);
-      }
-      const glm::vec3 ext = hi - lo;
-      const int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
-      const auto mid = members.begin() + std::ptrdiff_t(members.size() / 2);
-      std::nth_element(members.begin(), mid, members.end(),
-                       [&](uint32_t a, uint32_t b) { return figures.position[a][axis] < figures.position[b][axis]; });
+      const auto mid = members.begin() + std::ptrdiff_t(halveInSpace(members, figures.position));
       std::vector<uint32_t> upper(mid, members.end());
       members.erase(mid, members.end());
       std::sort(members.begin(), members.end());  // index order: the per-slice loops walk memory forwards
