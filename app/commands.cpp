@@ -47,7 +47,7 @@ nlohmann::ordered_json summaryJson(const RenderJobSettings& s, const RenderJobRe
   j["spp"] = r.spp;
   j["seconds"] = r.seconds;
   j["timings"] = {{"load", r.timings.load}, {"bvh", r.timings.bvh}, {"vpl", r.timings.vpl},
-                  {"cluster", r.timings.cluster}, {"render", r.timings.render}};
+                  {"cluster", r.timings.cluster}, {"irradiance", r.timings.irradiance}, {"render", r.timings.render}};
   if (s.mode != SamplingMode::Brdf)
     j["cluster_stages"] = {{"gather", r.timings.gather},          {"slices", r.timings.slices},
                            {"matrix", r.timings.matrix},          {"global", r.timings.globalClusters},
@@ -69,6 +69,7 @@ nlohmann::ordered_json summaryJson(const RenderJobSettings& s, const RenderJobRe
     j["acceptance"] = r.proposals > 0 ? double(r.accepted) / double(r.proposals) : 0.0;
     j["guide_bytes"] = r.guideBytes;
   }
+  if (s.tracer.roulette == RouletteRule::Vpl) j["branches_per_sample"] = r.samples > 0 ? double(r.branches) / double(r.samples) : 0.0;
   j["seed"] = s.seed;
   j["threads"] = tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
   j["scene"] = s.scenePath;

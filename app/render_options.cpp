@@ -63,8 +63,16 @@ void RenderOptions::addCommonTo(CLI::App& command) {
       ->check(CLI::Range(1, 1024));
   command.add_option("--rr-start", rrStart, "first path depth at which Russian roulette may end a path")
       ->check(CLI::Range(1, 1024));
-  command.add_option("--roulette", roulette, "Russian roulette survival: throughput (min(1, max beta)) | sqrt (its square root)")
-      ->check(CLI::IsMember({"throughput", "sqrt"}));
+  command.add_option("--roulette", roulette,
+                     "Russian roulette: throughput (survival min(1, max beta)) | sqrt (its square root) | "
+                     "vpl (a weight window on the VPLs' estimate, with splitting)")
+      ->check(CLI::IsMember({"throughput", "sqrt", "vpl"}));
+  command.add_option("--window", tracer.window.width, "vpl roulette: weight window width (paths within [2/(1+w), 2w/(1+w)] of the pixel's estimate go on as they are)")
+      ->check(CLI::Range(1.0f, 1000.0f));
+  command.add_option("--max-split", tracer.window.maxSplit, "vpl roulette: most branches a vertex splits into (1: roulette only)")
+      ->check(CLI::Range(1, 64));
+  command.add_option("--max-branches", tracer.window.maxBranches, "vpl roulette: most paths one camera sample grows into")
+      ->check(CLI::Range(1, 1024));
   command.add_option("--sky", sky, "uniform sky radiance R,G,B; 0 turns it off (default: on only without lights)");
   command.add_option("--exposure", exposure, "PNG exposure in stops");
   command.add_option("--vpls", preview.vpl.count, "number of VPLs")->check(CLI::Range(0, 50'000'000));
@@ -104,9 +112,10 @@ RenderJobSettings RenderOptions::toSettings() const {
   s.seed = seed;
   s.spp = spp > 0 ? spp : 16;
   s.timeBudget = time;
+  s.tracer = tracer;
   s.tracer.maxDepth = maxDepth;
   s.tracer.rrStartDepth = rrStart;
-  s.tracer.roulette = roulette == "sqrt" ? RouletteRule::Sqrt : RouletteRule::Throughput;
+  s.tracer.roulette = roulette == "sqrt" ? RouletteRule::Sqrt : roulette == "vpl" ? RouletteRule::Vpl : RouletteRule::Throughput;
   s.preview = preview;
   if (sliceSize > 0)
     s.preview.slices.maxSliceSize = sliceSize;

@@ -17,6 +17,7 @@ struct RenderOptions {
   int maxDepth = 32;
   int rrStart = PathTracerSettings{}.rrStartDepth;
   std::string roulette = "sqrt";
+  PathTracerSettings tracer;  // the weight window's flags (depth and rule come from the fields above)
   std::string out, png;
   std::string sky;  // "R,G,B", "0", or empty (automatic)
   float exposure = 0.0f;

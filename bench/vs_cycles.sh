@@ -13,7 +13,7 @@
 # 10 and 60, or one scene, can be run again separately) and OUT_DIR/vs_cycles.md (tables for the
 # README), and prints the latter.
 #
-# Environment: THREADS (2), SEEDS ("1 2"), MAX_DEPTH (32 = vplview's default; Cycles gets
+# Environment: MODES ("brdf mis"; a mode with "+vpl" appended runs with --roulette vpl), THREADS (2), SEEDS ("1 2"), MAX_DEPTH (32 = vplview's default; Cycles gets
 # --max-bounces MAX_DEPTH-1), SCENES (names to run, default all built-in), REF_SPP (overrides the
 # per-scene reference spp below), REF_THREADS (0 = all cores), CYCLES_RENDER (path of cycles-render),
 # CODE (how the tables name the code measured; default: the repository's commit).
@@ -28,7 +28,7 @@ budgets=${*:-10 60}
 here=$(cd "$(dirname "$0")/.." && pwd)
 exe=$build/vplview
 cycles=${CYCLES_RENDER:-$here/../shared/tools/cycles/cycles-render}
-THREADS=${THREADS:-2}; SEEDS=${SEEDS:-1 2}; MAX_DEPTH=${MAX_DEPTH:-32}; REF_THREADS=${REF_THREADS:-0}
+MODES=${MODES:-brdf mis}; THREADS=${THREADS:-2}; SEEDS=${SEEDS:-1 2}; MAX_DEPTH=${MAX_DEPTH:-32}; REF_THREADS=${REF_THREADS:-0}
 [ -x "$exe" ] || { echo "vs_cycles: no $exe (cmake --build BUILD_DIR --target vplview)" >&2; exit 2; }
 [ -x "$cycles" ] || { echo "vs_cycles: no $cycles (set CYCLES_RENDER)" >&2; exit 2; }
 command -v blender >/dev/null || { echo "vs_cycles: Blender is missing: apt-get install -y blender" >&2; exit 2; }
@@ -116,9 +116,11 @@ print(p, max(a - 16 * p, 0.0))" "${probe[@]}")
       read -r rel bias < <("$exe" compare "$img" "$ref" | json relmse bias)
       sps=$(python3 -c "import sys; w, h, n, s = map(float, sys.argv[1:]); print(f'{w * h * n / s:.6g}')" "$W" "$H" "$spp" "$secs")
       echo "$name,$t,cycles,path,$seed,$secs,$spp,$sps,$rel,$bias,$W,$H,$rspp" | tee -a "$log" >> "$csv"
-      for mode in brdf mis; do
+      for mode in $MODES; do
         img=$out/${name}_${t}s_${mode}_seed$seed.exr
-        read -r vsecs vspp < <("$exe" render "$scene" --mode $mode --time "$secs" --width "$W" --height "$H" \
+        flags="--mode ${mode%+vpl}"
+        [[ $mode == *+vpl ]] && flags="$flags --roulette vpl"
+        read -r vsecs vspp < <("$exe" render "$scene" $flags --time "$secs" --width "$W" --height "$H" \
                                   --threads "$THREADS" --seed "$seed" --max-depth "$MAX_DEPTH" --out "$img" | json seconds spp)
         read -r rel bias < <("$exe" compare "$img" "$ref" | json relmse bias)
         sps=$(python3 -c "import sys; w, h, n, s = map(float, sys.argv[1:]); print(f'{w * h * n / s:.6g}')" "$W" "$H" "$vspp" "$vsecs")
@@ -151,20 +153,21 @@ def fmt(x):
     return f"{x:.3g}" if x < 1000 else f"{x / 1e6:.2f} M" if x >= 1e6 else f"{x:.0f}"
 order = {"cornell_box": 0, "two_rooms": 1, "door_ajar": 2}
 keys = sorted({(r["scene"], r["budget"]) for r in rows}, key=lambda k: (order.get(k[0], 9), k[0], k[1]))
+modes = list(dict.fromkeys(r["mode"] for r in rows if r["renderer"] == "vplview"))
 print("## vplview against Cycles at equal time\n")
 print(f"`bench/vs_cycles.sh BUILD_DIR OUT_DIR [SECONDS...]`: Cycles 3.4.1 (`../shared/tools/cycles/cycles-render`, CPU) at a fixed spp")
-print(f"that takes about the budget, then vplview `brdf` and `mis` with `--time` = Cycles' seconds, alternating, {threads} threads each,")
+print(f"that takes about the budget, then vplview's modes ({', '.join(f'`{m}`' for m in modes)}; +vpl: `--roulette vpl`) with `--time` = Cycles' seconds, alternating, {threads} threads each,")
 print(f"max depth {depth} (Cycles `--max-bounces {int(depth) - 1}`); relMSE (DESIGN.md §4) against a converged vplview `reference`.")
 print(f"Ratios are vplview ÷ Cycles of the means over seeds (samples/s: width × height × spp ÷ seconds, set-up included).")
 print(f"Code: {commit}; {cpu}, {cores} cores. Timings on a shared machine are noisy.\n")
-print("| scene | budget | Cycles spp | brdf spp | brdf samples/s ÷ Cycles | brdf relMSE ÷ Cycles | mis spp | mis samples/s ÷ Cycles | mis relMSE ÷ Cycles |")
-print("|---|---|---|---|---|---|---|---|---|")
+print("| scene | budget | Cycles spp | " + " | ".join(f"{m} spp | {m} samples/s ÷ Cycles | {m} relMSE ÷ Cycles" for m in modes) + " |")
+print("|---|---|---|" + "---|---|---|" * len(modes))
 for scene, budget in keys:
     c = group(scene, budget, "cycles", "path")
     if not c:
         continue
     cells = [f"{mean(r['spp'] for r in c):.0f}"]
-    for mode in ("brdf", "mis"):
+    for mode in modes:
         v = group(scene, budget, "vplview", mode)
         if not v:
             cells += ["", "", ""]
@@ -180,7 +183,7 @@ for scene, budget in keys:
     print(f"### {scene}, {w}×{h}, {budget:g} s\n")
     print("| renderer | seeds | seconds | spp | samples/s | relMSE per seed | mean relMSE | bias | samples/s ÷ Cycles | relMSE ÷ Cycles |")
     print("|---|---|---|---|---|---|---|---|---|---|")
-    for renderer, mode, label in (("cycles", "path", "Cycles"), ("vplview", "brdf", "vplview brdf"), ("vplview", "mis", "vplview mis")):
+    for renderer, mode, label in [("cycles", "path", "Cycles")] + [("vplview", m, f"vplview {m}") for m in modes]:
         g = group(scene, budget, renderer, mode)
         if not g:
             continue

@@ -17,7 +17,6 @@ int GuidedContinuation::cachePoint(const SurfaceHit& hit) {
   if (hit.position != lastPosition_ || hit.shadingNormal != lastNormal_) {
     lastPosition_ = hit.position;
     lastNormal_ = hit.shadingNormal;
-    ++vertex_;
     const int maxGuided = field_.settings().guidedVertices;
     if (maxGuided > 0 && vertex_ > maxGuided) {
       lastCachePoint_ = -1;

@@ -24,8 +24,10 @@ class GuidedContinuation final : public ContinuationSampler {
   void beginPath(uint64_t pixel) override {
     chainsUsedByPath_.clear();
     pixel_ = pixel;
-    vertex_ = 0;
-    lastPosition_ = glm::vec3(NAN);  // a new path's first vertex is always a new vertex
+  }
+  void beginVertex(int depth) override {
+    vertex_ = depth + 1;
+    lastPosition_ = glm::vec3(NAN);  // a new vertex: look its cache point up again
   }
 
  private:
@@ -46,7 +48,7 @@ class GuidedContinuation final : public ContinuationSampler {
   glm::vec3 lastPosition_{NAN}, lastNormal_{NAN};
   int lastCachePoint_ = -1;
   uint64_t pixel_ = 0;
-  int vertex_ = 0;              // vertices of this path so far (1: the camera ray's hit)
+  int vertex_ = 0;              // the current vertex, from 1 (the camera ray's hit)
 };
 
 }  // namespace vpl

@@ -4,11 +4,14 @@
 // Parameters (PathTracerSettings):
 //   maxDepth      int   32    path segments from the camera; 1 = direct light only
 //   rrStartDepth  int   5     first depth at which Russian roulette may end a path
-//   roulette      enum  Sqrt  survival probability: min(1, sqrt(max throughput)) or min(1, max throughput)
+//   roulette      enum  Sqrt  survival probability: min(1, sqrt(max throughput)) or min(1, max throughput),
+//                             or Vpl: a weight window on the VPLs' estimate, with splitting (weight_window.h)
+//   window        WeightWindowSettings  the Vpl rule's window, split and branch limits
 #pragma once
 #include <cstdint>
 #include <string>
 #include <glm/glm.hpp>
+#include "render/integrator/weight_window.h"
 #include "render/sampling/pixel_sampler.h"
 #include "render/scene/render_scene.h"
 
@@ -16,13 +19,15 @@ namespace vpl {
 
 // How Russian roulette turns a path's throughput into a survival probability. The square root
 // (Cycles' rule) ends dim paths later, at more cost per sample. Square root from depth 5 had the
-// lowest equal-time error of six rules on three scenes (bench/roulette.sh, README).
-enum class RouletteRule { Throughput, Sqrt };
+// lowest equal-time error of six rules on three scenes (bench/roulette.sh, README). Vpl rules from
+// depth 1 by the VPLs' estimate of what a path is still worth, and splits the paths worth more.
+enum class RouletteRule { Throughput, Sqrt, Vpl };
 
 struct PathTracerSettings {
   int maxDepth = 32;
   int rrStartDepth = 5;
   RouletteRule roulette = RouletteRule::Sqrt;
+  WeightWindowSettings window;
 
   // Empty when valid, else a readable reason.
   std::string validate() const;
@@ -34,6 +39,7 @@ struct PathStats {
   uint64_t bsdfSamples = 0;   // continuation directions drawn from the BSDF
   uint64_t guideSamples = 0;  // continuation directions drawn from the guide
   uint64_t proposals = 0, accepted = 0;  // Metropolis mutations
+  uint64_t branches = 0;      // extra paths grown by splitting (the vpl roulette rule)
 };
 
 // How a vertex picks its continuation direction. The BSDF strategy is the reference; guided
@@ -51,6 +57,9 @@ class ContinuationSampler {
   virtual ~ContinuationSampler() = default;
   // Called at the start of every camera path, with its pixel (row-major index).
   virtual void beginPath(uint64_t /*pixel*/) {}
+  // Called at every vertex before anything is asked there; depth 0 is the camera ray's hit. A split
+  // path revisits depths, so a sampler must not count vertices itself.
+  virtual void beginVertex(int /*depth*/) {}
   // Picks a direction at this vertex from its numbers `u`; returns false when the path should end.
   virtual bool sample(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, VertexSamples& u,
                       DirectionSample& out, PathStats& stats) = 0;
@@ -66,9 +75,13 @@ class BsdfContinuation final : public ContinuationSampler {
   float pdf(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, const glm::vec3& wi) override;
 };
 
+class IrradianceGrid;
+
 class PathTracer {
  public:
-  PathTracer(const RenderScene& scene, const PathTracerSettings& settings) : scene_(scene), settings_(settings) {}
+  // `irradiance`: the VPLs' estimate that the Vpl roulette rule needs; without it (or with no light
+  // in it) that rule falls back to Sqrt. It must outlive the tracer.
+  PathTracer(const RenderScene& scene, const PathTracerSettings& settings, const IrradianceGrid* irradiance = nullptr);
 
   // Radiance arriving along the camera ray, every decision drawn from its dimension of `sampler`.
   // May be non-finite only through a bug; callers check.
@@ -82,10 +95,16 @@ class PathTracer {
   }
 
   const PathTracerSettings& settings() const { return settings_; }
+  bool usesWeightWindow() const { return irradiance_ != nullptr; }
 
  private:
+  struct Branch;
+  // Radiance reflected at a vertex towards the path, as the VPLs predict it (luminance).
+  float predictedRadiance(const SurfaceHit& surface, const Bsdf& bsdf) const;
+
   const RenderScene& scene_;
   PathTracerSettings settings_;
+  const IrradianceGrid* irradiance_ = nullptr;  // set only when the Vpl rule is in use
 };
 
 // Power heuristic with exponent 2 (Veach 1997, §9.2.4).

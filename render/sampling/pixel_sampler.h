@@ -50,11 +50,21 @@ class PixelSampler {
   // A slot read in 1D is the first coordinate of its 2D point.
   float get1D(int vertex, VertexDimension d) {
     const uint32_t slot = slotOf(vertex, d);
-    return vertex < kTabulatedVertices || independent_ ? get1D(slot) : hashedUniform(slot, 0);
+    return (vertex < kTabulatedVertices && !branch_) || independent_ ? get1D(slot) : hashedUniform(slot, 0);
   }
   glm::vec2 get2D(int vertex, VertexDimension d) {
     const uint32_t slot = slotOf(vertex, d);
-    return vertex < kTabulatedVertices || independent_ ? get2D(slot) : glm::vec2(hashedUniform(slot, 0), hashedUniform(slot, 1));
+    return (vertex < kTabulatedVertices && !branch_) || independent_ ? get2D(slot)
+                                                                     : glm::vec2(hashedUniform(slot, 0), hashedUniform(slot, 1));
+  }
+  // The numbers of a branch that a split path grows (render/integrator/weight_window.h): the
+  // branches of one vertex must not share numbers, and the stratified dimensions belong to the
+  // sample's first path, so a branch draws all its vertices from the hashed fallback, keyed by `id`.
+  PixelSampler branch(uint32_t id) const {
+    PixelSampler b = *this;
+    b.branch_ = true;
+    b.sampleKey_ = mix64(sampleKey_ ^ (0x6272616e63680000ull + id));
+    return b;
   }
   // A stream of its own for a vertex's consumer of an unbounded count of numbers.
   Rng random(int vertex) {
@@ -91,6 +101,7 @@ class PixelSampler {
   uint64_t pixelKey_ = 0;   // hash of (seed, pixel, the index's high half): the slots' scrambles
   uint64_t sampleKey_ = 0;  // hash of that and the whole index: the random fallback
   uint32_t reversedIndex_ = 0;  // the index's low 32 bits, bit-reversed
+  bool branch_ = false;         // a split path's branch: hashed numbers at every vertex
   Rng* independent_ = nullptr;
 };
 

@@ -226,6 +226,10 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
       vplSettings.seed = settings_.seed;
       vpls_ = std::make_shared<const VplSet>(traceVpls(scene, vplSettings));
     }
+    if (settings_.tracer.roulette == RouletteRule::Vpl && !irradiance_) {
+      irradiance_ = std::make_unique<IrradianceGrid>(scene, IrradianceGrid::kPhotons, settings_.seed);
+      windowTracer_ = std::make_unique<PathTracer>(scene, settings_.tracer, irradiance_.get());
+    }
     const double vplSeconds = secondsSince(t);
     t = Clock::now();
     PreviewSettings preview = settings_.maxSlices > 0 ? withAtMostSlices(settings_.preview, size_t(w) * size_t(h), settings_.maxSlices)
@@ -298,7 +302,7 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
     const SamplingMode mode = request.mode;
     continuation = [&guide, mode](uint32_t, uint64_t) { return std::make_unique<GuidedContinuation>(guide, mode); };
   }
-  const TileRenderer renderer(camera, settings_.seed, pathTracerShader(tracer_, continuation));
+  const TileRenderer renderer(camera, settings_.seed, pathTracerShader(windowTracer_ ? *windowTracer_ : tracer_, continuation));
   // A mode flipped back to shows its own film at once, if it has passed the handover.
   if (mine.complete >= settings_.handoverSpp)
     publish(mine.film->resolve(), SessionStage::Refine, mine.complete, mine.film->resolveVariance());

@@ -26,6 +26,7 @@
 #include "render/integrator/sampling_mode.h"
 #include "render/scene/camera.h"
 #include "render/scene/render_scene.h"
+#include "render/vpl/irradiance_grid.h"
 #include "render/vpl/vpl_preview.h"
 
 namespace vpl {
@@ -98,8 +99,11 @@ class ProgressiveSession {
 
   std::shared_ptr<const RenderScene> scene_;
   SessionSettings settings_;  // width and height change under mutex_; the rest is fixed
-  PathTracer tracer_;
+  PathTracer tracer_;                   // the quick frames' (and, without the vpl rule, every pass's)
   std::shared_ptr<const VplSet> vpls_;  // traced once per scene; only the controller touches it
+  // The vpl roulette rule's estimate and the tracer that uses it, made once per scene with the VPLs.
+  std::unique_ptr<IrradianceGrid> irradiance_;
+  std::unique_ptr<PathTracer> windowTracer_;
 
   mutable std::mutex mutex_;  // guards everything below up to the thread
   mutable std::condition_variable changed_;

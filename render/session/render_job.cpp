@@ -13,6 +13,7 @@
 #include "render/scene/camera.h"
 #include "render/scene/gltf_loader.h"
 #include "render/session/tile_renderer.h"
+#include "render/vpl/irradiance_grid.h"
 
 namespace vpl {
 
@@ -78,20 +79,30 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
   if (scene.usesDefaultSky()) result.notices.push_back("the scene has no light: lit by a uniform white sky (--sky to change, --sky 0 for none)");
 
   const Camera camera(defaultCamera(scene.data()), settings.width, settings.height);
-  const PathTracer tracer(scene, settings.tracer);
   // VPLs (camera-independent), then slices and clusters for this camera.
+  const bool vplRoulette = settings.tracer.roulette == RouletteRule::Vpl;
+  std::shared_ptr<VplSet> vpls;
+  if (settings.mode != SamplingMode::Brdf) {
+    const auto t = Clock::now();
+    VplSettings vplSettings = settings.preview.vpl;
+    vplSettings.seed = settings.seed;
+    vpls = std::make_shared<VplSet>(traceVpls(scene, vplSettings));
+    result.timings.vpl = secondsSince(t);
+    result.rays += vpls->rays;
+    result.vplCount = vpls->vpls.size();
+  }
+  IrradianceGrid irradiance;
+  if (vplRoulette) {
+    const auto t = Clock::now();
+    irradiance = IrradianceGrid(scene, IrradianceGrid::kPhotons, settings.seed);
+    result.timings.irradiance = secondsSince(t);
+  }
+  const PathTracer tracer(scene, settings.tracer, vplRoulette ? &irradiance : nullptr);
   VplField field;
   GuideField guide;
   PixelShaderFactory shader;
   if (settings.mode != SamplingMode::Brdf) {
-    auto t = Clock::now();
-    VplSettings vplSettings = settings.preview.vpl;
-    vplSettings.seed = settings.seed;
-    auto vpls = std::make_shared<VplSet>(traceVpls(scene, vplSettings));
-    result.timings.vpl = secondsSince(t);
-    result.rays += vpls->rays;
-    result.vplCount = vpls->vpls.size();
-    t = Clock::now();
+    const auto t = Clock::now();
     PreviewSettings preview = settings.preview;
     preview.clustering.seed = settings.seed;
     field = buildVplField(scene, camera, vpls, preview);
@@ -141,6 +152,7 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
     result.bsdfSamples += stats.bsdfSamples;
     result.guideSamples += stats.guideSamples;
     result.proposals += stats.proposals;
+    result.branches += stats.branches;
     result.accepted += stats.accepted;
     if (timed && pass > 0 && stop.load()) break;  // cut short: not a complete pass
     ++result.spp;

@@ -31,6 +31,7 @@ struct RenderJobSettings {
 
 struct PhaseTimings {
   double load = 0, bvh = 0, vpl = 0, cluster = 0, render = 0;
+  double irradiance = 0;  // the VPL roulette's irradiance grid
   // cluster's parts: gather points, slice tree, LightSlice (reduced matrix, global clusters, per-slice
   // refinement) and, in the guided modes, the guide
   double gather = 0, slices = 0, matrix = 0, globalClusters = 0, refine = 0, guide = 0;
@@ -47,6 +48,7 @@ struct RenderJobResult {
   size_t vplCount = 0, sliceCount = 0;
   double clustersPerSlice = 0.0;
   uint64_t proposals = 0, accepted = 0;  // Metropolis mutations
+  uint64_t branches = 0;                 // extra paths grown by splitting (the vpl roulette rule)
   size_t guideBytes = 0;
   std::vector<std::string> notices;
 };

@@ -48,6 +48,7 @@ PassStats TileRenderer::renderPass(Film& film, uint64_t pass, const std::atomic<
     stats.guideSamples += path.guideSamples;
     stats.proposals += path.proposals;
     stats.accepted += path.accepted;
+    stats.branches += path.branches;
   });
   PassStats total;
   perThread.combine_each([&](const PassStats& s) { total += s; });

@@ -19,10 +19,11 @@ struct PassStats {
   uint64_t discarded = 0;  // non-finite or negative samples dropped before the film
   uint64_t bsdfSamples = 0, guideSamples = 0;
   uint64_t proposals = 0, accepted = 0;
+  uint64_t branches = 0;
   PassStats& operator+=(const PassStats& o) {
     rays += o.rays; samples += o.samples; discarded += o.discarded;
     bsdfSamples += o.bsdfSamples; guideSamples += o.guideSamples;
-    proposals += o.proposals; accepted += o.accepted;
+    proposals += o.proposals; accepted += o.accepted; branches += o.branches;
     return *this;
   }
 };

@@ -1,5 +1,5 @@
 // Every guided mode converges to the image of BSDF sampling (DESIGN.md §2 step 8), pixel by pixel,
-// on every built-in scene. Each side is a set of independent batches (distinct seeds: new VPLs, new
+// on every built-in scene; so does the VPL-driven roulette and splitting (weight_window.h). Each side is a set of independent batches (distinct seeds: new VPLs, new
 // guide, new chains), so the per-pixel standard errors include everything that varies with the seed.
 // `brdf` itself is anchored to Cycles (test_cycles_anchor) and to analytic cases (furnace, sky plane,
 // light types), so a bug shared with next-event estimation or roulette does not cancel here.
@@ -24,7 +24,8 @@ std::string scenePath(const std::string& scene) {
 }
 
 RenderJobSettings settings(const std::string& scene, SamplingMode mode, int spp, uint64_t seed,
-                           int guidedVertices = GuideSettings{}.guidedVertices) {
+                           int guidedVertices = GuideSettings{}.guidedVertices,
+                           RouletteRule roulette = PathTracerSettings{}.roulette) {
   RenderJobSettings s;
   s.scenePath = scenePath(scene);
   s.mode = mode;
@@ -35,12 +36,14 @@ RenderJobSettings settings(const std::string& scene, SamplingMode mode, int spp,
   s.tracer.maxDepth = kMaxDepth;
   s.preview.vpl.count = 4096;
   s.guide.guidedVertices = guidedVertices;
+  s.tracer.roulette = roulette;
   return s;
 }
 
 // `batches` renders of `spp` each, seeds firstSeed, firstSeed + 1, ...; the scene is read once.
 test::BatchEstimate renderBatches(const SceneData& data, const RenderJobSettings& base, int batches, uint64_t firstSeed,
-                                  uint64_t* guideSamples = nullptr, uint64_t* discarded = nullptr) {
+                                  uint64_t* guideSamples = nullptr, uint64_t* discarded = nullptr,
+                                  uint64_t* branches = nullptr) {
   std::vector<Image> images;
   for (int b = 0; b < batches; ++b) {
     RenderJobSettings s = base;
@@ -48,6 +51,7 @@ test::BatchEstimate renderBatches(const SceneData& data, const RenderJobSettings
     const RenderJobResult r = runRenderJob(s, data);
     if (guideSamples) *guideSamples += r.guideSamples;
     if (discarded) *discarded += r.discarded;
+    if (branches) *branches += r.branches;
     images.push_back(r.image);
   }
   return test::estimateFromBatches(images);
@@ -57,12 +61,14 @@ struct Case {
   const char* scene;
   SamplingMode mode;
   int guidedVertices = GuideSettings{}.guidedVertices;  // 0: every vertex near a cache point
+  RouletteRule roulette = PathTracerSettings{}.roulette;
 };
 
 std::string caseName(const Case& c) {
   std::string scene = c.scene;
   scene = scene.substr(0, scene.find('.'));
-  return scene + "_" + modeName(c.mode) + (c.guidedVertices == 0 ? "_every_vertex" : "");
+  return scene + "_" + modeName(c.mode) + (c.guidedVertices == 0 ? "_every_vertex" : "") +
+         (c.roulette == RouletteRule::Vpl ? "_vpl_roulette" : "");
 }
 
 class GuidedModes : public ::testing::TestWithParam<Case> {};
@@ -74,10 +80,11 @@ TEST_P(GuidedModes, AgreeWithBsdfSamplingPixelByPixel) {
   const SceneData data = loadGltf(path);
   const test::BatchEstimate reference =
       renderBatches(data, settings(c.scene, SamplingMode::Brdf, kSpp, 0), kBatches, 1000);
-  uint64_t guideSamples = 0, discarded = 0;
-  const test::BatchEstimate guided =
-      renderBatches(data, settings(c.scene, c.mode, kSpp, 0, c.guidedVertices), kBatches, 2000, &guideSamples, &discarded);
-  EXPECT_GT(guideSamples, 0u) << "the guide was never used";
+  uint64_t guideSamples = 0, discarded = 0, branches = 0;
+  const test::BatchEstimate guided = renderBatches(data, settings(c.scene, c.mode, kSpp, 0, c.guidedVertices, c.roulette),
+                                                   kBatches, 2000, &guideSamples, &discarded, &branches);
+  if (c.mode != SamplingMode::Brdf) EXPECT_GT(guideSamples, 0u) << "the guide was never used";
+  if (c.roulette == RouletteRule::Vpl) EXPECT_GT(branches, 0u) << "no path was ever split";
   EXPECT_EQ(discarded, 0u);
   // Sampling glossy lobes from the guide alone (metropolis, mixture) leaves rare, large weights: at
   // 65536 spp one pixel of cornell_glossy still moved from 35 % below brdf to 50 % above it. Those
@@ -96,7 +103,11 @@ INSTANTIATE_TEST_SUITE_P(
                       Case{"two_rooms.gltf", SamplingMode::Mixture}, Case{"interior.glb", SamplingMode::Mis},  // the 157K-triangle hall: one mode, for CI time
                       // Guiding every vertex near a cache point (--guided-vertices 0).
                       Case{"two_rooms.gltf", SamplingMode::Mis, 0}, Case{"cornell_glossy.gltf", SamplingMode::Metropolis, 0},
-                      Case{"two_rooms.gltf", SamplingMode::Mixture, 0}),
+                      Case{"two_rooms.gltf", SamplingMode::Mixture, 0},
+                      // Roulette and splitting by the VPLs' estimate.
+                      Case{"cornell_box.gltf", SamplingMode::Brdf, 1, RouletteRule::Vpl},
+                      Case{"two_rooms.gltf", SamplingMode::Mis, 1, RouletteRule::Vpl},
+                      Case{"cornell_glossy.gltf", SamplingMode::Metropolis, 0, RouletteRule::Vpl}),
     [](const auto& info) { return caseName(info.param); });
 
 // The statistic is not blind: BSDF sampling against itself passes, and against itself 5 % brighter

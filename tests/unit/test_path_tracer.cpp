@@ -9,6 +9,7 @@
 #include "render/scene/camera.h"
 #include "render/scene/gltf_loader.h"
 #include "render/session/tile_renderer.h"
+#include "render/vpl/irradiance_grid.h"
 #include "tests/unit/scene_builders.h"
 #include "tests/unit/support.h"
 
@@ -27,7 +28,9 @@ Rendered renderScene(const RenderScene& scene, int width, int height, int spp, u
   settings.maxDepth = maxDepth;
   settings.roulette = roulette;
   settings.rrStartDepth = rrStart;
-  const PathTracer tracer(scene, settings);
+  IrradianceGrid irradiance;
+  if (roulette == RouletteRule::Vpl) irradiance = IrradianceGrid(scene, 1 << 16, seed);
+  const PathTracer tracer(scene, settings, &irradiance);
   const TileRenderer renderer(camera, seed, pathTracerShader(tracer));
   Film film(width, height);
   Rendered r;
@@ -69,13 +72,15 @@ TEST_P(WhiteFurnace, ConvergesToAnalyticRadiance) {
 
 std::string furnaceName(const ::testing::TestParamInfo<WhiteFurnace::ParamType>& info) {
   const float rho = std::get<0>(info.param);
-  return "albedo" + std::to_string(int(rho * 10)) + (std::get<1>(info.param) == RouletteRule::Sqrt ? "_sqrt" : "_throughput") +
+  const RouletteRule rule = std::get<1>(info.param);
+  return "albedo" + std::to_string(int(rho * 10)) +
+         (rule == RouletteRule::Sqrt ? "_sqrt" : rule == RouletteRule::Vpl ? "_vpl" : "_throughput") +
          "_from" + std::to_string(std::get<2>(info.param));
 }
 
 INSTANTIATE_TEST_SUITE_P(AlbedosAndRoulette, WhiteFurnace,
                          ::testing::Combine(::testing::Values(0.0f, 0.5f, 0.8f),
-                                            ::testing::Values(RouletteRule::Throughput, RouletteRule::Sqrt),
+                                            ::testing::Values(RouletteRule::Throughput, RouletteRule::Sqrt, RouletteRule::Vpl),
                                             ::testing::Values(1, 5)),
                          furnaceName);
 
