@@ -65,8 +65,9 @@ void RenderOptions::addCommonTo(CLI::App& command) {
       ->check(CLI::Range(1, 1024));
   command.add_option("--roulette", roulette,
                      "Russian roulette: throughput (survival min(1, max beta)) | sqrt (its square root) | "
-                     "vpl (a weight window on the VPLs' estimate, with splitting)")
-      ->check(CLI::IsMember({"throughput", "sqrt", "vpl"}));
+                     "vpl (a weight window on the VPLs' estimate, with splitting) | auto (vpl where the film's samples vary "
+                     "more than 10x their mean squared, else sqrt)")
+      ->check(CLI::IsMember({"throughput", "sqrt", "vpl", "auto"}));
   command.add_option("--window", tracer.window.width, "vpl roulette: weight window width (paths within [2/(1+w), 2w/(1+w)] of the pixel's estimate go on as they are)")
       ->check(CLI::Range(1.0f, 1000.0f));
   command.add_option("--max-split", tracer.window.maxSplit, "vpl roulette: most branches a vertex splits into (1: roulette only)")
@@ -115,7 +116,10 @@ RenderJobSettings RenderOptions::toSettings() const {
   s.tracer = tracer;
   s.tracer.maxDepth = maxDepth;
   s.tracer.rrStartDepth = rrStart;
-  s.tracer.roulette = roulette == "sqrt" ? RouletteRule::Sqrt : roulette == "vpl" ? RouletteRule::Vpl : RouletteRule::Throughput;
+  s.tracer.roulette = roulette == "sqrt"  ? RouletteRule::Sqrt
+                      : roulette == "vpl" ? RouletteRule::Vpl
+                      : roulette == "auto" ? RouletteRule::Auto
+                                           : RouletteRule::Throughput;
   s.preview = preview;
   if (sliceSize > 0)
     s.preview.slices.maxSliceSize = sliceSize;

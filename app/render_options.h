@@ -16,7 +16,7 @@ struct RenderOptions {
   int threads = 0;  // 0 = all cores
   int maxDepth = 32;
   int rrStart = PathTracerSettings{}.rrStartDepth;
-  std::string roulette = "sqrt";
+  std::string roulette = "auto";
   PathTracerSettings tracer;  // the weight window's flags (depth and rule come from the fields above)
   std::string out, png;
   std::string sky;  // "R,G,B", "0", or empty (automatic)

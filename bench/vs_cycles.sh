@@ -13,7 +13,7 @@
 # 10 and 60, or one scene, can be run again separately) and OUT_DIR/vs_cycles.md (tables for the
 # README), and prints the latter.
 #
-# Environment: MODES ("brdf mis"; a mode with "+vpl" appended runs with --roulette vpl), THREADS (2), SEEDS ("1 2"), MAX_DEPTH (32 = vplview's default; Cycles gets
+# Environment: MODES ("brdf mis"; MODE+RULE runs with --roulette RULE, e.g. brdf+vpl), THREADS (2), SEEDS ("1 2"), MAX_DEPTH (32 = vplview's default; Cycles gets
 # --max-bounces MAX_DEPTH-1), SCENES (names to run, default all built-in), REF_SPP (overrides the
 # per-scene reference spp below), REF_THREADS (0 = all cores), CYCLES_RENDER (path of cycles-render),
 # CODE (how the tables name the code measured; default: the repository's commit).
@@ -118,8 +118,8 @@ print(p, max(a - 16 * p, 0.0))" "${probe[@]}")
       echo "$name,$t,cycles,path,$seed,$secs,$spp,$sps,$rel,$bias,$W,$H,$rspp" | tee -a "$log" >> "$csv"
       for mode in $MODES; do
         img=$out/${name}_${t}s_${mode}_seed$seed.exr
-        flags="--mode ${mode%+vpl}"
-        [[ $mode == *+vpl ]] && flags="$flags --roulette vpl"
+        flags="--mode ${mode%%+*}"
+        [[ $mode == *+* ]] && flags="$flags --roulette ${mode#*+}"
         read -r vsecs vspp < <("$exe" render "$scene" $flags --time "$secs" --width "$W" --height "$H" \
                                   --threads "$THREADS" --seed "$seed" --max-depth "$MAX_DEPTH" --out "$img" | json seconds spp)
         read -r rel bias < <("$exe" compare "$img" "$ref" | json relmse bias)
@@ -156,7 +156,7 @@ keys = sorted({(r["scene"], r["budget"]) for r in rows}, key=lambda k: (order.ge
 modes = list(dict.fromkeys(r["mode"] for r in rows if r["renderer"] == "vplview"))
 print("## vplview against Cycles at equal time\n")
 print(f"`bench/vs_cycles.sh BUILD_DIR OUT_DIR [SECONDS...]`: Cycles 3.4.1 (`../shared/tools/cycles/cycles-render`, CPU) at a fixed spp")
-print(f"that takes about the budget, then vplview's modes ({', '.join(f'`{m}`' for m in modes)}; +vpl: `--roulette vpl`) with `--time` = Cycles' seconds, alternating, {threads} threads each,")
+print(f"that takes about the budget, then vplview's modes ({', '.join(f'`{m}`' for m in modes)}; MODE+RULE: `--roulette RULE`) with `--time` = Cycles' seconds, alternating, {threads} threads each,")
 print(f"max depth {depth} (Cycles `--max-bounces {int(depth) - 1}`); relMSE (DESIGN.md §4) against a converged vplview `reference`.")
 print(f"Ratios are vplview ÷ Cycles of the means over seeds (samples/s: width × height × spp ÷ seconds, set-up included).")
 print(f"Code: {commit}; {cpu}, {cores} cores. Timings on a shared machine are noisy.\n")

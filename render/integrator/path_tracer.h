@@ -4,8 +4,9 @@
 // Parameters (PathTracerSettings):
 //   maxDepth      int   32    path segments from the camera; 1 = direct light only
 //   rrStartDepth  int   5     first depth at which Russian roulette may end a path
-//   roulette      enum  Sqrt  survival probability: min(1, sqrt(max throughput)) or min(1, max throughput),
-//                             or Vpl: a weight window on the VPLs' estimate, with splitting (weight_window.h)
+//   roulette      enum  Auto  survival probability: min(1, sqrt(max throughput)) or min(1, max throughput),
+//                             or Vpl: a weight window on the VPLs' estimate, with splitting (weight_window.h);
+//                             Auto: Sqrt, or Vpl when the first passes vary more than their mean
 //   window        WeightWindowSettings  the Vpl rule's window, split and branch limits
 #pragma once
 #include <cstdint>
@@ -21,12 +22,13 @@ namespace vpl {
 // (Cycles' rule) ends dim paths later, at more cost per sample. Square root from depth 5 had the
 // lowest equal-time error of six rules on three scenes (bench/roulette.sh, README). Vpl rules from
 // depth 1 by the VPLs' estimate of what a path is still worth, and splits the paths worth more.
-enum class RouletteRule { Throughput, Sqrt, Vpl };
+// Auto is Sqrt until the caller's switch turns Vpl on (render/session/window_switch.h).
+enum class RouletteRule { Throughput, Sqrt, Vpl, Auto };
 
 struct PathTracerSettings {
   int maxDepth = 32;
   int rrStartDepth = 5;
-  RouletteRule roulette = RouletteRule::Sqrt;
+  RouletteRule roulette = RouletteRule::Auto;
   WeightWindowSettings window;
 
   // Empty when valid, else a readable reason.
@@ -79,9 +81,11 @@ class IrradianceGrid;
 
 class PathTracer {
  public:
-  // `irradiance`: the VPLs' estimate that the Vpl roulette rule needs; without it (or with no light
-  // in it) that rule falls back to Sqrt. It must outlive the tracer.
-  PathTracer(const RenderScene& scene, const PathTracerSettings& settings, const IrradianceGrid* irradiance = nullptr);
+  // `irradiance`: the VPLs' estimate that the Vpl and Auto rules need; without it (or with no light
+  // in it) they fall back to Sqrt. `windowOn` (Auto only): whether the window is used, read at
+  // every path, so it may change between passes; none means off. Both must outlive the tracer.
+  PathTracer(const RenderScene& scene, const PathTracerSettings& settings, const IrradianceGrid* irradiance = nullptr,
+             const bool* windowOn = nullptr);
 
   // Radiance arriving along the camera ray, every decision drawn from its dimension of `sampler`.
   // May be non-finite only through a bug; callers check.
@@ -95,7 +99,6 @@ class PathTracer {
   }
 
   const PathTracerSettings& settings() const { return settings_; }
-  bool usesWeightWindow() const { return irradiance_ != nullptr; }
 
  private:
   struct Branch;
@@ -104,7 +107,9 @@ class PathTracer {
 
   const RenderScene& scene_;
   PathTracerSettings settings_;
-  const IrradianceGrid* irradiance_ = nullptr;  // set only when the Vpl rule is in use
+  const IrradianceGrid* irradiance_ = nullptr;  // set only when the Vpl or Auto rule is in use
+  const bool* windowOn_ = nullptr;  // Auto: whether the window is used
+  static const bool kOff;
 };
 
 // Power heuristic with exponent 2 (Veach 1997, §9.2.4).

@@ -9,6 +9,7 @@
 #include "render/guide/guide_builder.h"
 #include "render/integrator/guided_continuation.h"
 #include "render/session/tile_renderer.h"
+#include "render/session/window_switch.h"
 
 namespace vpl {
 
@@ -54,6 +55,7 @@ struct ProgressiveSession::CameraState {
     std::unique_ptr<Film> film;
     uint64_t nextPass = 0;  // passes started (a cancelled pass still used its index)
     int complete = 0;
+    WindowSwitch window;  // the auto roulette rule's decision for this film
   };
   std::optional<Request> key;
   Clock::time_point restart = Clock::now();
@@ -226,10 +228,7 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
       vplSettings.seed = settings_.seed;
       vpls_ = std::make_shared<const VplSet>(traceVpls(scene, vplSettings));
     }
-    if (settings_.tracer.roulette == RouletteRule::Vpl && !irradiance_) {
-      irradiance_ = std::make_unique<IrradianceGrid>(scene, IrradianceGrid::kPhotons, settings_.seed);
-      windowTracer_ = std::make_unique<PathTracer>(scene, settings_.tracer, irradiance_.get());
-    }
+
     const double vplSeconds = secondsSince(t);
     t = Clock::now();
     PreviewSettings preview = settings_.maxSlices > 0 ? withAtMostSlices(settings_.preview, size_t(w) * size_t(h), settings_.maxSlices)
@@ -302,7 +301,19 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
     const SamplingMode mode = request.mode;
     continuation = [&guide, mode](uint32_t, uint64_t) { return std::make_unique<GuidedContinuation>(guide, mode); };
   }
-  const TileRenderer renderer(camera, settings_.seed, pathTracerShader(windowTracer_ ? *windowTracer_ : tracer_, continuation));
+  const RouletteRule rule = settings_.tracer.roulette;
+  auto refineTracer = [&]() -> const PathTracer& {
+    if (rule != RouletteRule::Vpl && !(rule == RouletteRule::Auto && mine.window.on())) return tracer_;
+    if (!windowTracer_) {  // once per scene, when a film first asks for it
+      irradiance_ = std::make_unique<IrradianceGrid>(scene, IrradianceGrid::kPhotons, settings_.seed);
+      PathTracerSettings windowed = settings_.tracer;
+      windowed.roulette = RouletteRule::Vpl;
+      windowTracer_ = std::make_unique<PathTracer>(scene, windowed, irradiance_.get());
+    }
+    return *windowTracer_;
+  };
+  std::optional<TileRenderer> renderer;
+  renderer.emplace(camera, settings_.seed, pathTracerShader(refineTracer(), continuation));
   // A mode flipped back to shows its own film at once, if it has passed the handover.
   if (mine.complete >= settings_.handoverSpp)
     publish(mine.film->resolve(), SessionStage::Refine, mine.complete, mine.film->resolveVariance());
@@ -312,7 +323,7 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
   }
   while (mine.complete < settings_.maxSpp) {
     const auto t = Clock::now();
-    const PassStats pass = renderer.renderPass(*mine.film, mine.nextPass++, &cancel_);
+    const PassStats pass = renderer->renderPass(*mine.film, mine.nextPass++, &cancel_);
     state.renderSeconds += secondsSince(t);
     state.samples += pass.samples;
     state.rays += pass.rays;
@@ -324,6 +335,11 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
     }
     if (cancelled()) return;
     ++mine.complete;
+    if (rule == RouletteRule::Auto && !mine.window.on() && WindowSwitch::updateDue(uint64_t(mine.complete)) &&
+        mine.window.update(*mine.film)) {
+      renderer.reset();
+      renderer.emplace(camera, settings_.seed, pathTracerShader(refineTracer(), continuation));
+    }
     if (mine.complete >= settings_.handoverSpp || preview.complete == 0)
       publish(mine.film->resolve(), SessionStage::Refine, mine.complete, mine.film->resolveVariance());
     noteTime();

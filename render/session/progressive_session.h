@@ -101,7 +101,8 @@ class ProgressiveSession {
   SessionSettings settings_;  // width and height change under mutex_; the rest is fixed
   PathTracer tracer_;                   // the quick frames' (and, without the vpl rule, every pass's)
   std::shared_ptr<const VplSet> vpls_;  // traced once per scene; only the controller touches it
-  // The vpl roulette rule's estimate and the tracer that uses it, made once per scene with the VPLs.
+  // The vpl roulette rule's estimate and the tracer that uses it, made once per scene when a film
+  // first uses the rule (at once with --roulette vpl, on the film's variance with auto).
   std::unique_ptr<IrradianceGrid> irradiance_;
   std::unique_ptr<PathTracer> windowTracer_;
 

@@ -13,6 +13,7 @@
 #include "render/scene/camera.h"
 #include "render/scene/gltf_loader.h"
 #include "render/session/tile_renderer.h"
+#include "render/session/window_switch.h"
 #include "render/vpl/irradiance_grid.h"
 
 namespace vpl {
@@ -97,10 +98,10 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
     irradiance = IrradianceGrid(scene, IrradianceGrid::kPhotons, settings.seed);
     result.timings.irradiance = secondsSince(t);
   }
-  const PathTracer tracer(scene, settings.tracer, vplRoulette ? &irradiance : nullptr);
+  auto tracer = std::make_unique<PathTracer>(scene, settings.tracer, vplRoulette ? &irradiance : nullptr);
   VplField field;
   GuideField guide;
-  PixelShaderFactory shader;
+  std::function<PixelShaderFactory(const PathTracer&)> shaderFor;
   if (settings.mode != SamplingMode::Brdf) {
     const auto t = Clock::now();
     PreviewSettings preview = settings.preview;
@@ -118,7 +119,7 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
     for (const SliceClusters& s : field.clusters.slices) clusterTotal += s.clusters.size();
     result.clustersPerSlice = field.tree.slices.empty() ? 0.0 : double(clusterTotal) / double(field.tree.slices.size());
     if (settings.mode == SamplingMode::Preview) {
-      shader = previewShader(scene, field, settings.preview);
+      shaderFor = [&](const PathTracer&) { return previewShader(scene, field, settings.preview); };
     } else {
       const auto guideStart = Clock::now();
       guide = buildGuideField(scene, field, settings.guide);
@@ -126,15 +127,20 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
       result.timings.cluster = secondsSince(t);
       result.guideBytes = guide.memoryBytes();
       const SamplingMode mode = settings.mode;
-      shader = pathTracerShader(tracer, [&guide, mode](uint32_t, uint64_t) {
-        return std::make_unique<GuidedContinuation>(guide, mode);
-      });
+      shaderFor = [&guide, mode](const PathTracer& t) {
+        return pathTracerShader(t, [&guide, mode](uint32_t, uint64_t) { return std::make_unique<GuidedContinuation>(guide, mode); });
+      };
     }
   } else {
-    shader = pathTracerShader(tracer);
+    shaderFor = [](const PathTracer& t) { return pathTracerShader(t); };
   }
-  const TileRenderer renderer(camera, settings.seed, shader);
+  std::optional<TileRenderer> renderer;
+  renderer.emplace(camera, settings.seed, shaderFor(*tracer));
   Film film(settings.width, settings.height);
+  // The auto rule: the film's variance decides whether the window is used; the VPLs' estimate is
+  // made when it first is.
+  const bool autoRoulette = settings.tracer.roulette == RouletteRule::Auto && settings.mode != SamplingMode::Preview;
+  WindowSwitch window;
 
   const auto renderStart = Clock::now();
   std::atomic<bool> stop{false};
@@ -145,7 +151,7 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
     if (!timed && int(pass) >= settings.spp) break;
     if (timed && pass > 0 && stop.load()) break;
     // The first pass always completes: a budget never leaves an empty image.
-    const PassStats stats = renderer.renderPass(film, pass, pass == 0 ? nullptr : &stop);
+    const PassStats stats = renderer->renderPass(film, pass, pass == 0 ? nullptr : &stop);
     result.rays += stats.rays;
     result.samples += stats.samples;
     result.discarded += stats.discarded;
@@ -157,6 +163,18 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
     if (timed && pass > 0 && stop.load()) break;  // cut short: not a complete pass
     ++result.spp;
     if (pass == 0) result.firstImageSeconds = secondsSince(loaded);
+    if (autoRoulette && !window.on() && WindowSwitch::updateDue(uint64_t(result.spp))) {
+      const bool on = window.update(film);
+      if (on) {
+        result.windowFromPass = result.spp;
+        const auto t = Clock::now();
+        irradiance = IrradianceGrid(scene, IrradianceGrid::kPhotons, settings.seed);
+        result.timings.irradiance = secondsSince(t);
+        renderer.reset();  // its shader holds the old tracer
+        tracer = std::make_unique<PathTracer>(scene, settings.tracer, &irradiance, window.flag());
+        renderer.emplace(camera, settings.seed, shaderFor(*tracer));
+      }
+    }
     if (progress) progress(timed ? std::min(1.0, secondsSince(loaded) / settings.timeBudget) : double(pass + 1) / settings.spp);
   }
   watch.reset();

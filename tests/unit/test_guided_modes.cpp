@@ -25,7 +25,7 @@ std::string scenePath(const std::string& scene) {
 
 RenderJobSettings settings(const std::string& scene, SamplingMode mode, int spp, uint64_t seed,
                            int guidedVertices = GuideSettings{}.guidedVertices,
-                           RouletteRule roulette = PathTracerSettings{}.roulette) {
+                           RouletteRule roulette = RouletteRule::Sqrt) {
   RenderJobSettings s;
   s.scenePath = scenePath(scene);
   s.mode = mode;
@@ -43,7 +43,7 @@ RenderJobSettings settings(const std::string& scene, SamplingMode mode, int spp,
 // `batches` renders of `spp` each, seeds firstSeed, firstSeed + 1, ...; the scene is read once.
 test::BatchEstimate renderBatches(const SceneData& data, const RenderJobSettings& base, int batches, uint64_t firstSeed,
                                   uint64_t* guideSamples = nullptr, uint64_t* discarded = nullptr,
-                                  uint64_t* branches = nullptr) {
+                                  uint64_t* branches = nullptr, int* windowed = nullptr) {
   std::vector<Image> images;
   for (int b = 0; b < batches; ++b) {
     RenderJobSettings s = base;
@@ -52,6 +52,7 @@ test::BatchEstimate renderBatches(const SceneData& data, const RenderJobSettings
     if (guideSamples) *guideSamples += r.guideSamples;
     if (discarded) *discarded += r.discarded;
     if (branches) *branches += r.branches;
+    if (windowed && r.windowFromPass > 0) ++*windowed;
     images.push_back(r.image);
   }
   return test::estimateFromBatches(images);
@@ -61,14 +62,14 @@ struct Case {
   const char* scene;
   SamplingMode mode;
   int guidedVertices = GuideSettings{}.guidedVertices;  // 0: every vertex near a cache point
-  RouletteRule roulette = PathTracerSettings{}.roulette;
+  RouletteRule roulette = RouletteRule::Sqrt;  // brdf, the reference, always uses it
 };
 
 std::string caseName(const Case& c) {
   std::string scene = c.scene;
   scene = scene.substr(0, scene.find('.'));
   return scene + "_" + modeName(c.mode) + (c.guidedVertices == 0 ? "_every_vertex" : "") +
-         (c.roulette == RouletteRule::Vpl ? "_vpl_roulette" : "");
+         (c.roulette == RouletteRule::Vpl ? "_vpl_roulette" : c.roulette == RouletteRule::Auto ? "_auto_roulette" : "");
 }
 
 class GuidedModes : public ::testing::TestWithParam<Case> {};
@@ -81,10 +82,12 @@ TEST_P(GuidedModes, AgreeWithBsdfSamplingPixelByPixel) {
   const test::BatchEstimate reference =
       renderBatches(data, settings(c.scene, SamplingMode::Brdf, kSpp, 0), kBatches, 1000);
   uint64_t guideSamples = 0, discarded = 0, branches = 0;
+  int windowed = 0;
   const test::BatchEstimate guided = renderBatches(data, settings(c.scene, c.mode, kSpp, 0, c.guidedVertices, c.roulette),
-                                                   kBatches, 2000, &guideSamples, &discarded, &branches);
+                                                   kBatches, 2000, &guideSamples, &discarded, &branches, &windowed);
   if (c.mode != SamplingMode::Brdf) EXPECT_GT(guideSamples, 0u) << "the guide was never used";
-  if (c.roulette == RouletteRule::Vpl) EXPECT_GT(branches, 0u) << "no path was ever split";
+  if (c.roulette == RouletteRule::Vpl || c.roulette == RouletteRule::Auto) EXPECT_GT(branches, 0u) << "no path was ever split";
+  if (c.roulette == RouletteRule::Auto) EXPECT_EQ(windowed, kBatches) << "the auto rule did not switch to the window";
   EXPECT_EQ(discarded, 0u);
   // Sampling glossy lobes from the guide alone (metropolis, mixture) leaves rare, large weights: at
   // 65536 spp one pixel of cornell_glossy still moved from 35 % below brdf to 50 % above it. Those
@@ -107,7 +110,8 @@ INSTANTIATE_TEST_SUITE_P(
                       // Roulette and splitting by the VPLs' estimate.
                       Case{"cornell_box.gltf", SamplingMode::Brdf, 1, RouletteRule::Vpl},
                       Case{"two_rooms.gltf", SamplingMode::Mis, 1, RouletteRule::Vpl},
-                      Case{"cornell_glossy.gltf", SamplingMode::Metropolis, 0, RouletteRule::Vpl}),
+                      Case{"cornell_glossy.gltf", SamplingMode::Metropolis, 0, RouletteRule::Vpl},
+                      Case{"door_ajar.gltf", SamplingMode::Brdf, 1, RouletteRule::Auto}),
     [](const auto& info) { return caseName(info.param); });
 
 // The statistic is not blind: BSDF sampling against itself passes, and against itself 5 % brighter

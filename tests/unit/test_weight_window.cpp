@@ -3,7 +3,9 @@
 // checked by the furnace (test_path_tracer) and pixel by pixel against the sqrt rule (test_guided_modes).
 #include <cmath>
 #include <gtest/gtest.h>
+#include "render/film/film.h"
 #include "render/integrator/weight_window.h"
+#include "render/session/window_switch.h"
 #include "render/sampling/rng.h"
 #include "render/vpl/irradiance_grid.h"
 #include "tests/unit/scene_builders.h"
@@ -66,6 +68,32 @@ TEST(IrradianceGrid, IsEmptyWithoutLight) {
   const IrradianceGrid grid(scene, 1 << 12, 1);
   EXPECT_TRUE(grid.empty());
   EXPECT_EQ(grid.irradiance(glm::vec3(0, -1, 0), glm::vec3(0, 1, 0)), glm::vec3(0.0f));
+}
+
+// The auto rule's switch reads the film's relative variance per sample: samples that are mostly
+// black with a rare bright one (light through a slit) turn it on, steady samples do not.
+TEST(WindowSwitch, TurnsOnWhereSamplesVaryMoreThanTheirMean) {
+  const auto filmOf = [](std::initializer_list<float> passes) {
+    Film film(8, 8);
+    for (const float v : passes)
+      for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x) film.addSample(x, y, glm::vec3(v));
+    return film;
+  };
+  WindowSwitch steady;
+  EXPECT_FALSE(steady.update(filmOf({1.0f, 1.5f, 1.0f, 1.5f})));
+  EXPECT_NEAR(steady.relativeVariance(), (1.0 / 12.0) / (1.25 * 1.25), 1e-3);  // 0.0833 / 1.5625, n/(n-1)-corrected
+  WindowSwitch rare;
+  EXPECT_TRUE(rare.update(filmOf({8.0f, 0.0f, 0.0f, 0.0f})));
+  EXPECT_NEAR(rare.relativeVariance(), 16.0 / 4.0, 1e-2);  // sample variance 16 around a mean of 2
+  // Once on it stays on, whatever later passes say.
+  EXPECT_TRUE(rare.update(filmOf({1.0f, 1.0f})));
+  // Read after the first passes only: the statistic creeps up as rare samples arrive.
+  EXPECT_FALSE(WindowSwitch::updateDue(1));
+  EXPECT_TRUE(WindowSwitch::updateDue(2));
+  EXPECT_FALSE(WindowSwitch::updateDue(3));
+  EXPECT_TRUE(WindowSwitch::updateDue(4));
+  EXPECT_FALSE(WindowSwitch::updateDue(8));
 }
 
 }  // namespace
