@@ -9,6 +9,18 @@
 
 namespace vpl {
 
+namespace {
+
+// The continuation at a vertex: direction and pdf in `dir`, f cos / pdf in `weight`. False ends the path.
+bool sampleContinuation(const SurfaceHit& surface, const Bsdf& bsdf, const glm::vec3& wo, VertexSamples& u,
+                        ContinuationSampler& continuation, PathStats& stats, DirectionSample& dir, glm::vec3& weight) {
+  if (!continuation.sample(surface, bsdf, wo, u, dir, stats)) return false;
+  weight = dir.weight.x >= 0.0f ? dir.weight : bsdf.eval(wo, dir.wi) / dir.pdf;
+  return !isBlack(weight) && glm::dot(dir.wi, surface.geometricNormal) > 0.0f;
+}
+
+}  // namespace
+
 std::string PathTracerSettings::validate() const {
   if (maxDepth < 1 || maxDepth > 1024) return "max depth must be between 1 and 1024";
   if (rrStartDepth < 1) return "Russian roulette start depth must be at least 1";
@@ -143,9 +155,8 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
         Branch next{Ray{}, glm::vec3(0.0f), surface, 0.0f, depth + 1, path.sampler.branch(nextBranchId++)};
         VertexSamples ub(next.sampler, depth);
         DirectionSample dir;
-        if (!continuation.sample(surface, bsdf, wo, ub, dir, stats)) continue;
-        const glm::vec3 weight = dir.weight.x >= 0.0f ? dir.weight : bsdf.eval(wo, dir.wi) / dir.pdf;
-        if (isBlack(weight) || glm::dot(dir.wi, surface.geometricNormal) <= 0.0f) continue;
+        glm::vec3 weight;
+        if (!sampleContinuation(surface, bsdf, wo, ub, continuation, stats, dir, weight)) continue;
         next.beta = branchBeta * weight;
         if (!isFiniteNonNegative(next.beta)) continue;
         next.ray = spawnRay(surface, dir.wi);
@@ -158,9 +169,8 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
 
       // Continuation direction.
       DirectionSample next;
-      if (!continuation.sample(surface, bsdf, wo, u, next, stats)) break;
-      const glm::vec3 weight = next.weight.x >= 0.0f ? next.weight : bsdf.eval(wo, next.wi) / next.pdf;
-      if (isBlack(weight) || glm::dot(next.wi, surface.geometricNormal) <= 0.0f) break;
+      glm::vec3 weight;
+      if (!sampleContinuation(surface, bsdf, wo, u, continuation, stats, next, weight)) break;
       beta *= weight;
       if (!isFiniteNonNegative(beta)) break;
 

@@ -26,7 +26,7 @@ MUTANTS = [
      "s.pdf = pmf * dist2 / light.area;",
      "area-light sampling pdf without the emitter's cosine"),
     ("no-roulette-weight", "render/integrator/path_tracer.cpp",
-     "      beta /= survive;",
+     "        beta /= survive;",
      "",
      "Russian roulette survivors not reweighted"),
     ("metropolis-always-accepts", "render/guide/metropolis_sampler.cpp",
@@ -41,6 +41,14 @@ MUTANTS = [
      "L += contribution / (float(m) * pmf);",
      "L += contribution * (float(clusters.size()) / float(m));",
      "the preview weights a sampled VPL cluster as if chosen uniformly"),
+    ("no-window-survival-weight", "render/integrator/path_tracer.cpp",
+     "            beta /= d.survival;",
+     "",
+     "the VPL weight window's survivors not reweighted"),
+    ("split-branches-keep-full-weight", "render/integrator/path_tracer.cpp",
+     "const glm::vec3 branchBeta = beta / float(split);",
+     "const glm::vec3 branchBeta = beta;",
+     "a split path's branches each carry the whole weight"),
 ]
 
 
