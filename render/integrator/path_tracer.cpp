@@ -43,17 +43,11 @@ float BsdfContinuation::pdf(const SurfaceHit&, const Bsdf& bsdf, const glm::vec3
   return bsdf.pdf(wo, wi);
 }
 
-PathTracer::PathTracer(const RenderScene& scene, const PathTracerSettings& settings, const IrradianceGrid* irradiance,
-                       const bool* windowOn)
+PathTracer::PathTracer(const RenderScene& scene, const PathTracerSettings& settings, const IrradianceGrid* irradiance)
     : scene_(scene), settings_(settings) {
   const bool windowRule = settings_.roulette == RouletteRule::Vpl || settings_.roulette == RouletteRule::Auto;
-  if (windowRule && irradiance && !irradiance->empty()) {
-    irradiance_ = irradiance;
-    if (settings_.roulette == RouletteRule::Auto) windowOn_ = windowOn ? windowOn : &kOff;
-  }
+  if (windowRule && irradiance && !irradiance->empty()) irradiance_ = irradiance;
 }
-
-const bool PathTracer::kOff = false;
 
 float PathTracer::predictedRadiance(const SurfaceHit& surface, const Bsdf& bsdf) const {
   // A diffuse reflector of the BSDF's albedo at normal incidence: rough, but only ever a ratio's input.
@@ -82,7 +76,6 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
   int branchesLeft = settings_.window.maxBranches - 1;
   uint32_t nextBranchId = 1;
   float pixelEstimate = 0.0f;  // the weight window's reference, set at the camera ray's hit
-  const bool useWindow = irradiance_ && (!windowOn_ || *windowOn_);
 
   Branch path{cameraRay, glm::vec3(1.0f), SurfaceHit{}, 0.0f, 0, sampler};
   for (;;) {
@@ -121,7 +114,7 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
       // worth much. The camera ray's hit sets the pixel's estimate, its own ratio is 1 by definition.
       int split = 1;
       bool windowed = false;  // the window decided here, so the throughput rule does not
-      if (useWindow) {
+      if (irradiance_) {
         const float predicted = predictedRadiance(surface, bsdf);
         if (depth == 0) {
           pixelEstimate = luminance(le) + predicted;

@@ -22,7 +22,8 @@ namespace vpl {
 // (Cycles' rule) ends dim paths later, at more cost per sample. Square root from depth 5 had the
 // lowest equal-time error of six rules on three scenes (bench/roulette.sh, README). Vpl rules from
 // depth 1 by the VPLs' estimate of what a path is still worth, and splits the paths worth more.
-// Auto is Sqrt until the caller's switch turns Vpl on (render/session/window_switch.h).
+// Auto is Sqrt until its caller decides that the window pays (render/session/window_switch.h) and
+// hands the tracer the VPLs' estimate.
 enum class RouletteRule { Throughput, Sqrt, Vpl, Auto };
 
 struct PathTracerSettings {
@@ -82,10 +83,8 @@ class IrradianceGrid;
 class PathTracer {
  public:
   // `irradiance`: the VPLs' estimate that the Vpl and Auto rules need; without it (or with no light
-  // in it) they fall back to Sqrt. `windowOn` (Auto only): whether the window is used, read at
-  // every path, so it may change between passes; none means off. Both must outlive the tracer.
-  PathTracer(const RenderScene& scene, const PathTracerSettings& settings, const IrradianceGrid* irradiance = nullptr,
-             const bool* windowOn = nullptr);
+  // in it) they are Sqrt, with it both are the window. It must outlive the tracer.
+  PathTracer(const RenderScene& scene, const PathTracerSettings& settings, const IrradianceGrid* irradiance = nullptr);
 
   // Radiance arriving along the camera ray, every decision drawn from its dimension of `sampler`.
   // May be non-finite only through a bug; callers check.
@@ -107,9 +106,7 @@ class PathTracer {
 
   const RenderScene& scene_;
   PathTracerSettings settings_;
-  const IrradianceGrid* irradiance_ = nullptr;  // set only when the Vpl or Auto rule is in use
-  const bool* windowOn_ = nullptr;  // Auto: whether the window is used
-  static const bool kOff;
+  const IrradianceGrid* irradiance_ = nullptr;  // set only when the window is in use
 };
 
 // Power heuristic with exponent 2 (Veach 1997, §9.2.4).

@@ -171,7 +171,7 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
         irradiance = IrradianceGrid(scene, IrradianceGrid::kPhotons, settings.seed);
         result.timings.irradiance = secondsSince(t);
         renderer.reset();  // its shader holds the old tracer
-        tracer = std::make_unique<PathTracer>(scene, settings.tracer, &irradiance, window.flag());
+        tracer = std::make_unique<PathTracer>(scene, settings.tracer, &irradiance);
         renderer.emplace(camera, settings.seed, shaderFor(*tracer));
       }
     }

@@ -32,8 +32,6 @@ class WindowSwitch {
   bool on() const { return on_; }
   // The statistic of the last update.
   double relativeVariance() const { return relativeVariance_; }
-  // The flag the path tracer reads between passes.
-  const bool* flag() const { return &on_; }
 
  private:
   bool on_ = false;
