@@ -72,7 +72,17 @@ struct PanelSettings {
   float bsdfProbability;
   float defensive;
   float uniformMutation;
+  int roulette;  // index into kRoulettes
 };
+
+constexpr RouletteRule kRoulettes[] = {RouletteRule::Auto, RouletteRule::Sqrt, RouletteRule::Throughput, RouletteRule::Vpl};
+constexpr const char* kRouletteNames[] = {"auto", "sqrt", "throughput", "vpl (VPL weight window)"};
+
+int rouletteIndex(RouletteRule rule) {
+  for (int i = 0; i < 4; ++i)
+    if (kRoulettes[i] == rule) return i;
+  return 0;
+}
 
 }  // namespace
 
@@ -125,7 +135,7 @@ int runViewer(const ViewerOptions& options) {
     auto session = std::make_unique<ProgressiveSession>(scene, start, settings);
     PanelSettings panel{settings.preview.vpl.count, settings.preview.clustering.clusterBudget,
                         settings.guide.coneAngle * 57.29578f, settings.guide.bsdfProbability, settings.guide.defensive,
-                        settings.guide.uniformMutation};
+                        settings.guide.uniformMutation, rouletteIndex(settings.tracer.roulette)};
 
     Image image, variance;
     uint64_t version = 0;
@@ -212,7 +222,8 @@ int runViewer(const ViewerOptions& options) {
                     1e3 * stats.firstFrameSeconds);
         ImGui::Text("VPLs %zu (%.2f s)  clusters %.2f s  guide %.2f s  cache points %zu", stats.vpls, stats.vplSeconds,
                     stats.clusterSeconds, stats.guideSeconds, stats.cachePoints);
-        ImGui::Text("UI %.0f fps  discarded samples %llu", io.Framerate, static_cast<unsigned long long>(stats.discarded));
+        ImGui::Text("UI %.0f fps  discarded samples %llu  roulette %s", io.Framerate,
+                    static_cast<unsigned long long>(stats.discarded), stats.rouletteWindow ? "VPL window" : settings.tracer.roulette == RouletteRule::Throughput ? "throughput" : "sqrt");
         if (ImGui::CollapsingHeader("VPLs and guide")) {
           ImGui::InputInt("VPLs", &panel.vpls, 1024, 8192);
           ImGui::InputInt("clusters per slice", &panel.clusters, 10, 100);
@@ -220,6 +231,7 @@ int runViewer(const ViewerOptions& options) {
           ImGui::SliderFloat("MIS BSDF probability", &panel.bsdfProbability, 0.0f, 1.0f);
           ImGui::SliderFloat("defensive", &panel.defensive, 0.001f, 1.0f);
           ImGui::SliderFloat("uniform mutation", &panel.uniformMutation, 0.0f, 1.0f);
+          ImGui::Combo("roulette", &panel.roulette, kRouletteNames, 4);
           if (ImGui::Button("apply (restarts)")) {
             SessionSettings next = settings;
             next.mode = stats.mode;
@@ -231,6 +243,7 @@ int runViewer(const ViewerOptions& options) {
             next.guide.bsdfProbability = std::clamp(panel.bsdfProbability, 0.0f, 1.0f);
             next.guide.defensive = std::clamp(panel.defensive, 0.001f, 1.0f);
             next.guide.uniformMutation = std::clamp(panel.uniformMutation, 0.0f, 1.0f);
+            next.tracer.roulette = kRoulettes[std::clamp(panel.roulette, 0, 3)];
             session.reset();  // joins the old controller before the new one starts
             session = std::make_unique<ProgressiveSession>(scene, controller.camera(), next);
             settings = next;

@@ -314,6 +314,11 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
   };
   std::optional<TileRenderer> renderer;
   renderer.emplace(camera, settings_.seed, pathTracerShader(refineTracer(), continuation));
+  const auto noteWindow = [&] {
+    std::lock_guard lock(mutex_);
+    stats_.rouletteWindow = rule == RouletteRule::Vpl || (rule == RouletteRule::Auto && mine.window.on());
+  };
+  noteWindow();
   // A mode flipped back to shows its own film at once, if it has passed the handover.
   if (mine.complete >= settings_.handoverSpp)
     publish(mine.film->resolve(), SessionStage::Refine, mine.complete, mine.film->resolveVariance());
@@ -339,6 +344,7 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
         mine.window.update(*mine.film)) {
       renderer.reset();
       renderer.emplace(camera, settings_.seed, pathTracerShader(refineTracer(), continuation));
+      noteWindow();
     }
     if (mine.complete >= settings_.handoverSpp || preview.complete == 0)
       publish(mine.film->resolve(), SessionStage::Refine, mine.complete, mine.film->resolveVariance());

@@ -63,6 +63,7 @@ struct SessionStats {
   size_t vpls = 0, cachePoints = 0;
   uint64_t discarded = 0;
   uint64_t restarts = 0;
+  bool rouletteWindow = false;  // the film shown uses the VPL weight window (--roulette vpl, or auto switched)
 };
 
 class ProgressiveSession {
