@@ -14,4 +14,5 @@ export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 export LSAN_OPTIONS="suppressions=$repo/tests/sanitizers/lsan.supp:print_suppressions=0"
 # The sanitizer runs of the sanitizer tests themselves (the fuzzer has ASan of its own), and the
 # Node validator, are left out.
-cd "$asan" && ctest --output-on-failure --timeout 900 -E "asan_suite|tsan_session|fuzz_loader|gltf_validator"
+# In parallel (the plain suite runs so too): alone at the end of a CI run, it is the critical path.
+cd "$asan" && ctest -j "$(nproc)" --output-on-failure --timeout 900 -E "asan_suite|tsan_session|fuzz_loader|gltf_validator"

@@ -1,0 +1,64 @@
+#!/usr/bin/env bash
+# The authors' setting (Hua & Low 2015, their Figure 1): one-bounce indirect light (--max-depth 2),
+# equal spp, relMSE of `brdf`, `metropolis` and `mis` against a converged `brdf` reference of the same
+# depth. Their claim: MIS has the lowest error of the three. Issue 16 keeps it as an ablation row.
+#
+#   bench/one_bounce.sh BUILD_DIR OUT_DIR [SPP]        (default 64)
+#
+# Environment: SCENES ("door_ajar two_rooms cornell_box"), SEEDS ("1 2"), THREADS (2), REF_SPP (2048),
+# SIZE ("160 120"), ROULETTE (the roulette rule of every render; default: the program's).
+# The reference is cached in OUT_DIR by the scene's content hash, size, spp and depth. Writes
+# OUT_DIR/one_bounce.csv and prints a Markdown table: mean relMSE over seeds, and each mode's ÷ brdf's.
+set -euo pipefail
+build=$(cd "${1:?usage: one_bounce.sh BUILD_DIR OUT_DIR [SPP]}" && pwd)
+out=${2:?usage: one_bounce.sh BUILD_DIR OUT_DIR [SPP]}
+spp=${3:-64}
+here=$(cd "$(dirname "$0")/.." && pwd)
+exe=$build/vplview
+SCENES=${SCENES:-door_ajar two_rooms cornell_box}; SEEDS=${SEEDS:-1 2}; THREADS=${THREADS:-2}
+REF_SPP=${REF_SPP:-2048}; read -r W H <<<"${SIZE:-160 120}"
+rule=${ROULETTE:+--roulette $ROULETTE}
+[ -x "$exe" ] || { echo "one_bounce: no $exe" >&2; exit 2; }
+[[ $spp =~ ^[0-9]+$ ]] || { echo "one_bounce: '$spp' is not a sample count" >&2; exit 2; }
+mkdir -p "$out"; out=$(cd "$out" && pwd)
+csv=$out/one_bounce.csv
+echo "scene,mode,seed,spp,seconds,relmse" > "$csv"
+json() { python3 -c 'import json,sys; j=json.loads(sys.stdin.read().strip().splitlines()[-1]); print(" ".join(str(j[k]) for k in sys.argv[1:]))' "$@"; }
+
+for name in $SCENES; do
+  scene=$here/scenes/$name.gltf
+  [ -f "$scene" ] || scene=$build/scenes/$name.glb
+  [ -f "$scene" ] || { echo "one_bounce: no scene $name" >&2; exit 2; }
+  bin=${scene%.*}.bin
+  hash=$(cat "$scene" $([ -f "$bin" ] && echo "$bin") | sha1sum | cut -c1-10)
+  ref=$out/ref_${name}_${hash}_${W}x${H}_${REF_SPP}spp_d2.exr
+  if [ ! -f "$ref" ]; then
+    echo "$(date -Is) $name: reference, $REF_SPP spp, depth 2" >&2
+    "$exe" reference "$scene" --spp "$REF_SPP" --width $W --height $H --threads 0 --max-depth 2 --out "$ref.tmp.exr" >/dev/null
+    mv "$ref.tmp.exr" "$ref"
+  fi
+  for seed in $SEEDS; do
+    for mode in brdf metropolis mis; do
+      img=$out/${name}_${mode}_seed$seed.exr
+      read -r secs < <("$exe" render "$scene" --mode $mode --spp "$spp" --width $W --height $H --threads $THREADS \
+                          --seed $seed --max-depth 2 $rule --out "$img" | json seconds)
+      rel=$("$exe" compare "$img" "$ref" | json relmse)
+      echo "$name,$mode,$seed,$spp,$secs,$rel" | tee -a /dev/stderr >> "$csv"
+    done
+  done
+done
+
+python3 - "$csv" <<'PY'
+import csv, sys
+from statistics import mean
+rows = list(csv.DictReader(open(sys.argv[1])))
+scenes = list(dict.fromkeys(r["scene"] for r in rows))
+print("| scene | spp | brdf relMSE | metropolis relMSE (÷ brdf) | mis relMSE (÷ brdf) | seconds brdf / metropolis / mis |")
+print("|---|---|---|---|---|---|")
+for s in scenes:
+    m = {mode: [r for r in rows if r["scene"] == s and r["mode"] == mode] for mode in ("brdf", "metropolis", "mis")}
+    rel = {k: mean(float(r["relmse"]) for r in v) for k, v in m.items()}
+    sec = {k: mean(float(r["seconds"]) for r in v) for k, v in m.items()}
+    print(f"| {s} | {m['brdf'][0]['spp']} | {rel['brdf']:.4g} | {rel['metropolis']:.4g} ({rel['metropolis'] / rel['brdf']:.2f}) | "
+          f"{rel['mis']:.4g} ({rel['mis'] / rel['brdf']:.2f}) | {sec['brdf']:.1f} / {sec['metropolis']:.1f} / {sec['mis']:.1f} |")
+PY
