@@ -23,14 +23,11 @@ rule=${ROULETTE:+--roulette $ROULETTE}
 mkdir -p "$out"; out=$(cd "$out" && pwd)
 csv=$out/one_bounce.csv
 echo "scene,mode,seed,spp,seconds,relmse" > "$csv"
-json() { python3 -c 'import json,sys; j=json.loads(sys.stdin.read().strip().splitlines()[-1]); print(" ".join(str(j[k]) for k in sys.argv[1:]))' "$@"; }
+. "$here/bench/lib.sh"
 
 for name in $SCENES; do
-  scene=$here/scenes/$name.gltf
-  [ -f "$scene" ] || scene=$build/scenes/$name.glb
-  [ -f "$scene" ] || { echo "one_bounce: no scene $name" >&2; exit 2; }
-  bin=${scene%.*}.bin
-  hash=$(cat "$scene" $([ -f "$bin" ] && echo "$bin") | sha1sum | cut -c1-10)
+  scene=$(scene_file "$here" "$build" "$name" one_bounce)
+  hash=$(scene_hash "$scene")
   ref=$out/ref_${name}_${hash}_${W}x${H}_${REF_SPP}spp_d2.exr
   if [ ! -f "$ref" ]; then
     echo "$(date -Is) $name: reference, $REF_SPP spp, depth 2" >&2

@@ -25,15 +25,12 @@ SEEDS=${SEEDS:-1 2 3}; THREADS=${THREADS:-2}; REF_SPP=${REF_SPP:-4096}
 mkdir -p "$out"; out=$(cd "$out" && pwd)
 csv=$out/roulette.csv
 echo "scene,mode,rule,start,seed,budget,spp,relmse" > "$csv"
-json() { python3 -c 'import json,sys; j=json.loads(sys.stdin.read().strip().splitlines()[-1]); print(" ".join(str(j[k]) for k in sys.argv[1:]))' "$@"; }
+. "$here/bench/lib.sh"
 
 for name in $SCENES; do
-  scene=$here/scenes/$name.gltf
-  [ -f "$scene" ] || scene=$build/scenes/$name.glb
-  [ -f "$scene" ] || { echo "roulette: no scene $name" >&2; exit 2; }
+  scene=$(scene_file "$here" "$build" "$name" roulette)
   if [ -n "${SIZE:-}" ]; then read -r W H <<<"$SIZE"; elif [ "$name" = cornell_box ]; then W=256 H=256; else W=320 H=240; fi
-  bin=${scene%.*}.bin
-  hash=$(cat "$scene" $([ -f "$bin" ] && echo "$bin") | sha1sum | cut -c1-10)
+  hash=$(scene_hash "$scene")
   ref=$out/ref_${name}_${hash}_${W}x${H}_${REF_SPP}spp_d32.exr
   if [ ! -f "$ref" ]; then
     echo "$(date -Is) $name: reference, $REF_SPP spp" >&2

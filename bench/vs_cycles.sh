@@ -47,8 +47,7 @@ header="scene,budget,renderer,mode,seed,seconds,spp,samples_per_s,relmse,bias,wi
 size_of() { case $1 in cornell_box) echo "256 256";; *) echo "320 240";; esac; }
 ref_spp_of() { if [ -n "${REF_SPP:-}" ]; then echo "$REF_SPP"; else case $1 in cornell_box) echo 16384;; *) echo 8192;; esac; fi; }
 
-# Last line of a command's output is one JSON object; print the given keys of it, space-separated.
-json() { python3 -c 'import json,sys; j=json.loads(sys.stdin.read().strip().splitlines()[-1]); print(" ".join(str(j[k]) for k in sys.argv[1:]))' "$@"; }
+. "$here/bench/lib.sh"
 
 # Keep the rows of budgets not in this run.
 tmp_csv=$(mktemp)
@@ -96,8 +95,7 @@ if p <= 0.0 or a - 16 * p < 0.0: p = b / 64   # noise: no fixed part
 print(p, max(a - 16 * p, 0.0))" "${probe[@]}")
   echo "$name ${W}x$H: Cycles probes at 16 and 64 spp: ${probe[*]} s -> $per_spp s/spp + $fixed s" | tee -a "$log"
 
-  bin=${scene%.*}.bin
-  hash=$(cat "$scene" $([ -f "$bin" ] && echo "$bin") | sha1sum | cut -c1-10)
+  hash=$(scene_hash "$scene")
   rspp=$(ref_spp_of "$name")
   ref=$out/ref_${name}_${hash}_${W}x${H}_${rspp}spp_d${MAX_DEPTH}.exr
   if [ ! -f "$ref" ]; then

@@ -22,7 +22,7 @@ SEEDS=${SEEDS:-1 2}; THREADS=${THREADS:-2}; MAX_DEPTH=${MAX_DEPTH:-32}
 [ -x "$exe" ] || { echo "vs_cycles_equal_spp: no $exe" >&2; exit 2; }
 [ -x "$cycles" ] || { echo "vs_cycles_equal_spp: no $cycles (set CYCLES_RENDER)" >&2; exit 2; }
 for n in $counts; do [[ $n =~ ^[1-9][0-9]*$ ]] || { echo "vs_cycles_equal_spp: '$n' is not a sample count" >&2; exit 2; }; done
-json() { python3 -c 'import json,sys; j=json.loads(sys.stdin.read().strip().splitlines()[-1]); print(" ".join(str(j[k]) for k in sys.argv[1:]))' "$@"; }
+. "$here/bench/lib.sh"
 csv=$out/equal_spp_${counts// /_}.csv
 echo "scene,spp,renderer,mode,seed,seconds,relmse" > "$csv"
 
