@@ -228,7 +228,6 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
       vplSettings.seed = settings_.seed;
       vpls_ = std::make_shared<const VplSet>(traceVpls(scene, vplSettings));
     }
-
     const double vplSeconds = secondsSince(t);
     t = Clock::now();
     PreviewSettings preview = settings_.maxSlices > 0 ? withAtMostSlices(settings_.preview, size_t(w) * size_t(h), settings_.maxSlices)

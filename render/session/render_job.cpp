@@ -92,13 +92,16 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
     result.rays += vpls->rays;
     result.vplCount = vpls->vpls.size();
   }
+  // The VPL weight window's estimate and a tracer that uses it: at once for the vpl rule, when the
+  // switch turns on for auto.
   IrradianceGrid irradiance;
-  if (vplRoulette) {
+  const auto windowTracer = [&] {
     const auto t = Clock::now();
     irradiance = IrradianceGrid(scene, IrradianceGrid::kPhotons, settings.seed);
     result.timings.irradiance = secondsSince(t);
-  }
-  auto tracer = std::make_unique<PathTracer>(scene, settings.tracer, vplRoulette ? &irradiance : nullptr);
+    return std::make_unique<PathTracer>(scene, settings.tracer, &irradiance);
+  };
+  std::unique_ptr<PathTracer> tracer = vplRoulette ? windowTracer() : std::make_unique<PathTracer>(scene, settings.tracer);
   VplField field;
   GuideField guide;
   std::function<PixelShaderFactory(const PathTracer&)> shaderFor;
@@ -137,8 +140,7 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
   std::optional<TileRenderer> renderer;
   renderer.emplace(camera, settings.seed, shaderFor(*tracer));
   Film film(settings.width, settings.height);
-  // The auto rule: the film's variance decides whether the window is used; the VPLs' estimate is
-  // made when it first is.
+  // The auto rule: the film's first passes decide whether the window is used.
   const bool autoRoulette = settings.tracer.roulette == RouletteRule::Auto && settings.mode != SamplingMode::Preview;
   WindowSwitch window;
 
@@ -164,14 +166,10 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
     ++result.spp;
     if (pass == 0) result.firstImageSeconds = secondsSince(loaded);
     if (autoRoulette && !window.on() && WindowSwitch::updateDue(uint64_t(result.spp))) {
-      const bool on = window.update(film);
-      if (on) {
+      if (window.update(film)) {
         result.windowFromPass = result.spp;
-        const auto t = Clock::now();
-        irradiance = IrradianceGrid(scene, IrradianceGrid::kPhotons, settings.seed);
-        result.timings.irradiance = secondsSince(t);
         renderer.reset();  // its shader holds the old tracer
-        tracer = std::make_unique<PathTracer>(scene, settings.tracer, &irradiance);
+        tracer = windowTracer();
         renderer.emplace(camera, settings.seed, shaderFor(*tracer));
       }
     }
