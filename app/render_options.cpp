@@ -59,9 +59,9 @@ void RenderOptions::addCommonTo(CLI::App& command) {
   command.add_option("--height", height, "image height in pixels")->check(CLI::Range(1, 16384));
   command.add_option("--seed", seed, "random seed (same seed, same image)");
   command.add_option("--threads", threads, "worker threads (0: all cores)")->check(CLI::Range(0, 1024));
-  command.add_option("--max-depth", maxDepth, "maximum path length in segments (1: direct light only)")
+  command.add_option("--max-depth", tracer.maxDepth, "maximum path length in segments (1: direct light only)")
       ->check(CLI::Range(1, 1024));
-  command.add_option("--rr-start", rrStart, "first path depth at which Russian roulette may end a path")
+  command.add_option("--rr-start", tracer.rrStartDepth, "first path depth at which Russian roulette may end a path")
       ->check(CLI::Range(1, 1024));
   command.add_option("--roulette", roulette,
                      "Russian roulette: throughput (survival min(1, max beta)) | sqrt (its square root) | "
@@ -114,8 +114,6 @@ RenderJobSettings RenderOptions::toSettings() const {
   s.spp = spp > 0 ? spp : 16;
   s.timeBudget = time;
   s.tracer = tracer;
-  s.tracer.maxDepth = maxDepth;
-  s.tracer.rrStartDepth = rrStart;
   s.tracer.roulette = roulette == "sqrt"  ? RouletteRule::Sqrt
                       : roulette == "vpl" ? RouletteRule::Vpl
                       : roulette == "auto" ? RouletteRule::Auto

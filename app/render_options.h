@@ -14,10 +14,8 @@ struct RenderOptions {
   int width = 640, height = 480;
   uint64_t seed = 1;
   int threads = 0;  // 0 = all cores
-  int maxDepth = 32;
-  int rrStart = PathTracerSettings{}.rrStartDepth;
   std::string roulette = "auto";
-  PathTracerSettings tracer;  // the weight window's flags (depth and rule come from the fields above)
+  PathTracerSettings tracer;  // depth, roulette start and the weight window's flags (the rule: `roulette`)
   std::string out, png;
   std::string sky;  // "R,G,B", "0", or empty (automatic)
   float exposure = 0.0f;

@@ -58,6 +58,19 @@ Image Film::resolveVariance() const {
   return image;
 }
 
+double Film::sampleRelativeVariance() const {
+  double variance = 0.0, mean2 = 0.0;
+  for (size_t i = 0, n = size_t(width_) * size_t(height_); i < n; ++i) {
+    const Pixel& p = pixels_[i];
+    const uint32_t count = p.count.load(kRelaxed);
+    if (count < 2) continue;
+    const double mean = luminance(glm::vec3(float(p.r.load(kRelaxed)), float(p.g.load(kRelaxed)), float(p.b.load(kRelaxed)))) / count;
+    variance += std::max(0.0, (p.lum2.load(kRelaxed) / count - mean * mean) * count / (count - 1));
+    mean2 += mean * mean;
+  }
+  return mean2 > 0.0 ? variance / mean2 : 0.0;
+}
+
 uint64_t Film::totalSamples() const {
   uint64_t total = 0;
   for (size_t i = 0, n = size_t(width_) * size_t(height_); i < n; ++i) total += pixels_[i].count.load(kRelaxed);

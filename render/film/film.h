@@ -26,6 +26,9 @@ class Film {
   Image resolve() const;           // per-pixel mean; pixels without samples are black
   Image resolveVariance() const;   // per-pixel relative variance of the mean luminance, in all channels
   uint64_t totalSamples() const;
+  // The image's relative variance per sample, brightness-weighted: the sum over pixels of the
+  // luminance samples' variance over the sum of their squared means (0 without two samples).
+  double sampleRelativeVariance() const;
 
  private:
   struct Pixel {

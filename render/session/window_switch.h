@@ -25,9 +25,8 @@ class WindowSwitch {
 
   // True after `passes` complete passes when update() should be called: after 2 and 4.
   static bool updateDue(uint64_t passes) { return passes == 2 || passes == 4; }
-  // Reads the film's relative variance per sample (sum of per-pixel sample variances of the
-  // luminance over the sum of squared means); switches on above kThreshold. Once on, it stays on:
-  // the film then mixes both rules' samples. Returns on().
+  // Reads the film's relative variance per sample (Film::sampleRelativeVariance); switches on above
+  // kThreshold. Once on, it stays on: the film then mixes both rules' samples. Returns on().
   bool update(const Film& film);
   bool on() const { return on_; }
   // The statistic of the last update.
