@@ -107,7 +107,7 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
       }
       if (depth + 1 > settings_.maxDepth) break;
 
-      const Bsdf bsdf = scene_.bsdf(surface);
+      const Bsdf bsdf = scene_.bsdf(surface, wo);
       VertexSamples u(path.sampler, depth);
 
       // The weight window: roulette for paths worth little against the pixel, splitting for those

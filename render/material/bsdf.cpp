@@ -40,24 +40,34 @@ glm::vec3 Bsdf::specularAlbedo(float mu) const {
 }
 
 // Probability of sampling the specular lobe: its share of the albedo seen from wo.
-float Bsdf::specularProbability(float cosO) const {
+float Bsdf::specularProbability(const glm::vec3& albedo) const {
   if (!hasSpecular()) return 0.0f;
-  const glm::vec3 e = specularAlbedo(cosO);
-  const float spec = luminance(e);
-  const float diff = luminance(params_.diffuse * (glm::vec3(1.0f) - e));
+  const float spec = luminance(albedo);
+  const float diff = luminance(params_.diffuse * (glm::vec3(1.0f) - albedo));
   if (spec + diff <= 0.0f) return 0.5f;
   return spec / (spec + diff);
 }
 
-glm::vec3 Bsdf::evalLocal(const glm::vec3& wo, const glm::vec3& wi) const {
+Bsdf::Outgoing Bsdf::outgoingTerms(const glm::vec3& woWorld) const {
+  Outgoing o;
+  o.local = frame_.toLocal(woWorld);
+  if (hasSpecular() && o.local.z > 0.0f) {
+    o.albedo = specularAlbedo(o.local.z);
+    o.specularProbability = specularProbability(o.albedo);
+    o.lambda = ggx::lambda(o.local, params_.alpha);
+  }
+  return o;
+}
+
+glm::vec3 Bsdf::evalLocal(const Outgoing& o, const glm::vec3& wi) const {
+  const glm::vec3& wo = o.local;
   if (wo.z <= 0.0f || wi.z <= 0.0f) return glm::vec3(0.0f);
   glm::vec3 f(0.0f);
   if (!isBlack(diffuseScale_)) {
     if (hasSpecular()) {
-      const glm::vec3 eo = specularAlbedo(wo.z);
       const AlbedoTerms ti = vpl::specularAlbedo(wi.z, params_.alpha);
       const glm::vec3 ei = glm::clamp(params_.f0 * ti.a + params_.f90 * ti.b, glm::vec3(0.0f), glm::vec3(1.0f));
-      f += diffuseScale_ * (glm::vec3(1.0f) - eo) * (glm::vec3(1.0f) - ei) * wi.z;
+      f += diffuseScale_ * (glm::vec3(1.0f) - o.albedo) * (glm::vec3(1.0f) - ei) * wi.z;
     } else {
       f += diffuseScale_ * wi.z;
     }
@@ -67,50 +77,53 @@ glm::vec3 Bsdf::evalLocal(const glm::vec3& wo, const glm::vec3& wi) const {
     const float len = glm::length(h);
     if (len > 1e-8f) {
       h /= len;
-      // F D G2 / (4 cos_o cos_i), times cos_i.
-      f += ggx::schlick(params_.f0, params_.f90, glm::dot(wo, h)) *
-           (ggx::D(h, params_.alpha) * ggx::G2(wo, wi, params_.alpha) / (4.0f * wo.z));
+      // F D G2 / (4 cos_o cos_i), times cos_i; G2 is height-correlated Smith, 1 / (1 + Lambda_o + Lambda_i).
+      const float g2 = 1.0f / (1.0f + o.lambda + ggx::lambda(wi, params_.alpha));
+      f += ggx::schlick(params_.f0, params_.f90, glm::dot(wo, h)) * (ggx::D(h, params_.alpha) * g2 / (4.0f * wo.z));
     }
   }
   return f;
 }
 
-float Bsdf::pdfLocal(const glm::vec3& wo, const glm::vec3& wi) const {
+float Bsdf::pdfLocal(const Outgoing& o, const glm::vec3& wi) const {
+  const glm::vec3& wo = o.local;
   if (wo.z <= 0.0f || wi.z <= 0.0f) return 0.0f;
-  const float pSpec = specularProbability(wo.z);
+  const float pSpec = o.specularProbability;
   float pdf = (1.0f - pSpec) * cosineHemispherePdf(wi.z);
   if (pSpec > 0.0f) {
     glm::vec3 h = wo + wi;
     const float len = glm::length(h);
-    if (len > 1e-8f) pdf += pSpec * ggx::reflectionPdf(wo, h / len, params_.alpha);
+    // The visible normals' density reflected: G1(wo) D(h) / (4 wo.z).
+    if (len > 1e-8f) pdf += pSpec * ((1.0f / (1.0f + o.lambda)) * ggx::D(h / len, params_.alpha) / (4.0f * wo.z));
   }
   return pdf;
 }
 
 glm::vec3 Bsdf::eval(const glm::vec3& wo, const glm::vec3& wi) const {
-  return evalLocal(frame_.toLocal(wo), frame_.toLocal(wi));
+  return evalLocal(outgoing(wo), frame_.toLocal(wi));
 }
 
 float Bsdf::pdf(const glm::vec3& wo, const glm::vec3& wi) const {
-  return pdfLocal(frame_.toLocal(wo), frame_.toLocal(wi));
+  return pdfLocal(outgoing(wo), frame_.toLocal(wi));
 }
 
 std::optional<BsdfSample> Bsdf::sample(const glm::vec3& woWorld, glm::vec2 u, float uLobe) const {
-  const glm::vec3 wo = frame_.toLocal(woWorld);
-  if (wo.z <= 0.0f) return std::nullopt;
-  return sampleLobe(wo, u, uLobe < specularProbability(wo.z));
+  const Outgoing o = outgoing(woWorld);
+  if (o.local.z <= 0.0f) return std::nullopt;
+  return sampleLobe(o, u, uLobe < o.specularProbability);
 }
 
 std::optional<BsdfSample> Bsdf::sample(const glm::vec3& woWorld, glm::vec2 u) const {
-  const glm::vec3 wo = frame_.toLocal(woWorld);
-  if (wo.z <= 0.0f) return std::nullopt;
-  const float pSpec = specularProbability(wo.z);
+  const Outgoing o = outgoing(woWorld);
+  if (o.local.z <= 0.0f) return std::nullopt;
+  const float pSpec = o.specularProbability;
   const bool specular = u.x < pSpec;  // never true when pSpec is 0, always when it is 1
   u.x = std::min(specular ? u.x / pSpec : (u.x - pSpec) / (1.0f - pSpec), 0x1.fffffep-1f);
-  return sampleLobe(wo, u, specular);
+  return sampleLobe(o, u, specular);
 }
 
-std::optional<BsdfSample> Bsdf::sampleLobe(const glm::vec3& wo, glm::vec2 u, bool specular) const {
+std::optional<BsdfSample> Bsdf::sampleLobe(const Outgoing& o, glm::vec2 u, bool specular) const {
+  const glm::vec3& wo = o.local;
   glm::vec3 wi;
   if (specular) {
     const glm::vec3 h = ggx::sampleVisibleNormal(wo, u, params_.alpha);
@@ -119,12 +132,12 @@ std::optional<BsdfSample> Bsdf::sampleLobe(const glm::vec3& wo, glm::vec2 u, boo
     wi = sampleCosineHemisphere(u);
   }
   if (wi.z <= 0.0f) return std::nullopt;
-  const float pdf = pdfLocal(wo, wi);
+  const float pdf = pdfLocal(o, wi);
   if (!(pdf > 0.0f) || !std::isfinite(pdf)) return std::nullopt;
   BsdfSample s;
   s.wi = glm::normalize(frame_.toWorld(wi));
   s.pdf = pdf;
-  s.weight = evalLocal(wo, wi) / pdf;
+  s.weight = evalLocal(o, wi) / pdf;
   if (!isFiniteNonNegative(s.weight)) return std::nullopt;
   return s;
 }
@@ -132,7 +145,7 @@ std::optional<BsdfSample> Bsdf::sampleLobe(const glm::vec3& wo, glm::vec2 u, boo
 bool Bsdf::isNearSpecular() const {
   // Below alpha 0.01 (roughness 0.1) the lobe is a few degrees wide: a VPL there would light the
   // scene in sharp spikes, so light paths pass through it without storing one.
-  return params_.alpha < 0.01f && specularProbability(1.0f) > 0.9f;
+  return params_.alpha < 0.01f && specularProbability(specularAlbedo(1.0f)) > 0.9f;
 }
 
 }  // namespace vpl

@@ -30,6 +30,22 @@ class Bsdf {
 
   Bsdf() = default;
   Bsdf(const BsdfParams& params, const Frame& shadingFrame);
+  // The same lobes in another frame: a material's BSDF made once and placed at each hit.
+  Bsdf inFrame(const Frame& shadingFrame) const {
+    Bsdf b = *this;
+    b.frame_ = shadingFrame;
+    b.bound_ = false;
+    return b;
+  }
+  // Keeps the terms that depend on wo alone (its albedo, lobe probability, masking), so the
+  // evaluations, pdfs and samples of one path vertex compute them once. Calls with any other wo
+  // compute their own; a bound BSDF belongs to one thread, as a path vertex does.
+  void bindOutgoing(const glm::vec3& wo) {
+    bound_ = false;
+    outgoing_ = outgoingTerms(wo);
+    boundWo_ = wo;
+    bound_ = true;
+  }
 
   // f(wo, wi) |cos theta_i|, world-space directions.
   glm::vec3 eval(const glm::vec3& wo, const glm::vec3& wi) const;
@@ -51,14 +67,27 @@ class Bsdf {
   Frame frame_;
   glm::vec3 diffuseScale_{0.0f};  // diffuse / (pi (1 - E_avg)): the coupled diffuse lobe's constant
 
-  // E(mu) per channel; 0 without a specular lobe. Not cached: one BSDF is read by several threads at
-  // once (LightSlice's rows), and a table lookup costs less than keeping a cache coherent.
+  // What eval, pdf and sample need of wo besides wo itself (local frame).
+  struct Outgoing {
+    glm::vec3 local{0.0f};
+    glm::vec3 albedo{0.0f};         // E(wo.z) per channel: the specular lobe's share of the coupling
+    float specularProbability = 0;  // chance of sampling the specular lobe
+    float lambda = 0;               // Smith Lambda(wo)
+  };
+  bool bound_ = false;
+  glm::vec3 boundWo_{0.0f};
+  Outgoing outgoing_;
+
+  // E(mu) per channel; 0 without a specular lobe. A table lookup: cheaper than any cache shared
+  // between the threads that read one BSDF at once (LightSlice's rows); bindOutgoing() keeps wo's.
   glm::vec3 specularAlbedo(float mu) const;
   bool hasSpecular() const { return params_.f90 > 0.0f || params_.f0.x > 0.0f || params_.f0.y > 0.0f || params_.f0.z > 0.0f; }
-  float specularProbability(float cosO) const;
-  std::optional<BsdfSample> sampleLobe(const glm::vec3& woLocal, glm::vec2 u, bool specular) const;
-  glm::vec3 evalLocal(const glm::vec3& wo, const glm::vec3& wi) const;
-  float pdfLocal(const glm::vec3& wo, const glm::vec3& wi) const;
+  float specularProbability(const glm::vec3& albedo) const;
+  Outgoing outgoingTerms(const glm::vec3& woWorld) const;
+  Outgoing outgoing(const glm::vec3& woWorld) const { return bound_ && woWorld == boundWo_ ? outgoing_ : outgoingTerms(woWorld); }
+  std::optional<BsdfSample> sampleLobe(const Outgoing& wo, glm::vec2 u, bool specular) const;
+  glm::vec3 evalLocal(const Outgoing& wo, const glm::vec3& wi) const;
+  float pdfLocal(const Outgoing& wo, const glm::vec3& wi) const;
 };
 
 // f0 of the glTF metallic-roughness model with KHR_materials_specular / KHR_materials_ior.

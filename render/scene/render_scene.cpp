@@ -11,7 +11,24 @@ RenderScene::RenderScene(SceneData data, const SkySettings& sky) : data_(std::mo
   radius_ = 0.5f * glm::length(data_.boundsMax - data_.boundsMin);
   if (!(radius_ > 0.0f) || !std::isfinite(radius_)) radius_ = 1.0f;
   if (data_.materials.empty()) data_.materials.push_back(Material{});
+  for (const Material& m : data_.materials) {
+    const bool textured = m.baseColorTexture >= 0 || m.metallicRoughnessTexture >= 0;
+    uniformBsdfs_.push_back(textured ? std::nullopt : std::optional<Bsdf>(Bsdf(bsdfParams(m, {}), Frame{})));
+  }
   accel_ = std::make_unique<Accel>(data_);
+  triangles_.reserve(data_.meshes.size());
+  for (const MeshData& mesh : data_.meshes) {
+    std::vector<TriangleFacts>& facts = triangles_.emplace_back(mesh.indices.size() / 3);
+    for (size_t t = 0; t < facts.size(); ++t) {
+      const uint32_t* idx = &mesh.indices[3 * t];
+      const glm::vec3 p0 = mesh.positions[idx[0]], p1 = mesh.positions[idx[1]], p2 = mesh.positions[idx[2]];
+      const glm::vec3 magnitude = glm::max(glm::abs(p0), glm::max(glm::abs(p1), glm::abs(p2)));
+      facts[t].coordinateScale = std::max(magnitude.x, std::max(magnitude.y, magnitude.z));
+      const glm::vec3 ng = glm::cross(p1 - p0, p2 - p0);
+      const float len = glm::length(ng);
+      if (len > 0.0f) facts[t].normal = ng / len;
+    }
+  }
 
   bool hasLight = !data_.lights.empty();
   for (const MeshData& mesh : data_.meshes) hasLight = hasLight || data_.materials[mesh.material].isEmissive();
@@ -36,12 +53,11 @@ SurfaceHit RenderScene::surface(const Ray& ray, const RayHit& hit) const {
   s.material = mesh.material;
   // Barycentric interpolation is more precise than origin + t * direction far from the origin.
   s.position = p0 * b0 + p1 * hit.u + p2 * hit.v;
-  const glm::vec3 magnitude = glm::max(glm::abs(p0), glm::max(glm::abs(p1), glm::abs(p2)));
-  s.coordinateScale = std::max(magnitude.x, std::max(magnitude.y, magnitude.z));
+  const TriangleFacts& facts = triangles_[hit.mesh][hit.triangle];
+  s.coordinateScale = facts.coordinateScale;
 
-  glm::vec3 ng = glm::cross(p1 - p0, p2 - p0);
-  const float len = glm::length(ng);
-  ng = len > 0.0f ? ng / len : -ray.direction;
+  glm::vec3 ng = facts.normal;
+  if (ng == glm::vec3(0.0f)) ng = -ray.direction;  // degenerate: Embree should not report it, but be safe
   s.frontFace = glm::dot(ng, ray.direction) < 0.0f;
   if (!s.frontFace) ng = -ng;  // shade the side the ray came from (two-sided shading)
   s.geometricNormal = ng;
@@ -62,7 +78,11 @@ SurfaceHit RenderScene::surface(const Ray& ray, const RayHit& hit) const {
 }
 
 BsdfParams RenderScene::bsdfParams(const SurfaceHit& hit) const {
-  const Material& m = data_.materials[hit.material];
+  const std::optional<Bsdf>& uniform = uniformBsdfs_[hit.material];
+  return uniform ? uniform->params() : bsdfParams(data_.materials[hit.material], hit);
+}
+
+BsdfParams RenderScene::bsdfParams(const Material& m, const SurfaceHit& hit) const {
   glm::vec3 baseColor = m.baseColor;
   float metallic = m.metallic, roughness = m.roughness;
   if (m.baseColorTexture >= 0)

@@ -3,6 +3,8 @@
 #pragma once
 #include <algorithm>
 #include <memory>
+#include <optional>
+#include <vector>
 #include <glm/glm.hpp>
 #include "render/material/bsdf.h"
 #include "render/scene/accel.h"
@@ -39,10 +41,31 @@ class RenderScene {
   SurfaceHit surface(const Ray& ray, const RayHit& hit) const;
   // BSDF parameters at a hit: texture lookups only for textured materials.
   BsdfParams bsdfParams(const SurfaceHit& hit) const;
-  Bsdf bsdf(const SurfaceHit& hit) const { return Bsdf(bsdfParams(hit), Frame::fromNormal(hit.shadingNormal)); }
+  Bsdf bsdf(const SurfaceHit& hit) const {
+    const Frame frame = Frame::fromNormal(hit.shadingNormal);
+    const std::optional<Bsdf>& uniform = uniformBsdfs_[hit.material];
+    return uniform ? uniform->inFrame(frame) : Bsdf(bsdfParams(hit), frame);
+  }
+  // The BSDF of a path vertex, bound to the direction the path arrived from (Bsdf::bindOutgoing).
+  Bsdf bsdf(const SurfaceHit& hit, const glm::vec3& wo) const {
+    Bsdf b = bsdf(hit);
+    b.bindOutgoing(wo);
+    return b;
+  }
 
  private:
+  BsdfParams bsdfParams(const Material& material, const SurfaceHit& hit) const;
+
+  // What a hit needs of its triangle that no ray changes: made once, read at every hit.
+  struct TriangleFacts {
+    glm::vec3 normal{0.0f};  // unit winding normal; zero for a degenerate triangle
+    float coordinateScale = 1.0f;
+  };
+
   SceneData data_;
+  std::vector<std::vector<TriangleFacts>> triangles_;  // per mesh, per triangle
+  // Per material, its BSDF when no texture varies it over the surface (made once, placed per hit).
+  std::vector<std::optional<Bsdf>> uniformBsdfs_;
   std::unique_ptr<Accel> accel_;
   EmitterSet emitters_;
   glm::vec3 centre_{0.0f};

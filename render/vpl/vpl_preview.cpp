@@ -137,7 +137,7 @@ glm::vec3 reflectedLight(const RenderScene& scene, SurfaceHit surface, Bsdf bsdf
     surface = scene.surface(ray, hit);
     wo = -ray.direction;
     L += beta * emitters.emitted(surface, wo);
-    bsdf = scene.bsdf(surface);
+    bsdf = scene.bsdf(surface, wo);
     if (!bsdf.isNearSpecular()) return L + beta * directLight(scene, surface, bsdf, wo, VertexSamples(sampler, bounce + 1), stats);
   }
   return L;
@@ -187,7 +187,7 @@ PixelShaderFactory previewShader(const RenderScene& scene, const VplField& field
       const SurfaceHit surface = scene.surface(ray, hit);
       const glm::vec3 wo = -ray.direction;
       glm::vec3 L = emitters.emitted(surface, wo);
-      const Bsdf bsdf = scene.bsdf(surface);
+      const Bsdf bsdf = scene.bsdf(surface, wo);
       if (bsdf.isNearSpecular()) return L + reflectedLight(scene, surface, bsdf, wo, sampler, stats);
       L += directLight(scene, surface, bsdf, wo, VertexSamples(sampler, 0), stats);
 

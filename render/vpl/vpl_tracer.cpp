@@ -39,8 +39,8 @@ void traceLightPath(const RenderScene& scene, const VplSettings& settings, uint6
     ++out.rays;
     if (!hit.valid()) break;
     const SurfaceHit surface = scene.surface(ray, hit);
-    const Bsdf bsdf = scene.bsdf(surface);
     const glm::vec3 wo = -ray.direction;
+    const Bsdf bsdf = scene.bsdf(surface, wo);
     if (!bsdf.isNearSpecular()) {
       Vpl v;
       v.position = surface.position;
