@@ -69,6 +69,11 @@ nlohmann::ordered_json summaryJson(const RenderJobSettings& s, const RenderJobRe
     j["acceptance"] = r.proposals > 0 ? double(r.accepted) / double(r.proposals) : 0.0;
     j["guide_bytes"] = r.guideBytes;
   }
+  if (s.mode == SamplingMode::Mis) {  // learned: the mean over cache points with enough samples (null: none yet)
+    if (!s.guide.learnSelection) j["bsdf_prob"] = s.guide.bsdfProbability;
+    else if (r.learnedBsdfProbability >= 0.0) j["bsdf_prob"] = r.learnedBsdfProbability;
+    else j["bsdf_prob"] = nullptr;
+  }
   if (s.tracer.roulette == RouletteRule::Vpl || s.tracer.roulette == RouletteRule::Auto)
     j["branches_per_sample"] = r.samples > 0 ? double(r.branches) / double(r.samples) : 0.0;
   if (s.tracer.roulette == RouletteRule::Auto) j["window_from_pass"] = r.windowFromPass;

@@ -65,8 +65,8 @@ void RenderOptions::addCommonTo(CLI::App& command) {
       ->check(CLI::Range(1, 1024));
   command.add_option("--roulette", roulette,
                      "Russian roulette: throughput (survival min(1, max beta)) | sqrt (its square root) | "
-                     "vpl (a weight window on the VPLs' estimate, with splitting) | auto (vpl where the film's samples vary "
-                     "more than 10x their mean squared, else sqrt)")
+                     "vpl (a weight window on the VPLs' estimate, with splitting) | auto (vpl where the first passes' samples "
+                     "vary more than their mean, else sqrt)")
       ->check(CLI::IsMember({"throughput", "sqrt", "vpl", "auto"}));
   command.add_option("--window", tracer.window.width, "vpl roulette: weight window width (paths within [2/(1+w), 2w/(1+w)] of the pixel's estimate go on as they are)")
       ->check(CLI::Range(1.0f, 1000.0f));
@@ -99,7 +99,23 @@ void RenderOptions::addCommonTo(CLI::App& command) {
       ->check(CLI::Range(0.0f, 1.0f));
   command.add_option("--perturb", perturbDegrees, "Metropolis perturbation cone, degrees")->check(CLI::Range(0.01f, 180.0f));
   command.add_option("--mutations", guide.mutations, "Metropolis steps per direction")->check(CLI::Range(1, 1000));
-  command.add_option("--bsdf-prob", guide.bsdfProbability, "mis: probability of sampling the BSDF")->check(CLI::Range(0.0f, 1.0f));
+  command.add_option("--bsdf-prob", bsdfProb,
+                     "mis: probability of sampling the BSDF, P in [0, 1] everywhere (default 0.5, the paper's), or auto: "
+                     "each cache point learns its own from the paths, starting at 0.5")
+      ->check([](const std::string& v) -> std::string {
+        if (v == "auto") return {};
+        try {
+          size_t used = 0;
+          const float p = std::stof(v, &used);
+          if (used == v.size() && p >= 0.0f && p <= 1.0f) return {};
+        } catch (const std::exception&) {
+        }
+        return "--bsdf-prob must be auto or a number in [0, 1], not '" + v + "'";
+      });
+  command.add_option("--mis-guide", misGuide,
+                     "mis: where guide directions come from: exact (samples of the guide from the BSDF's stratified "
+                     "number) | chain (the cache point's Metropolis chain, as the paper)")
+      ->check(CLI::IsMember({"exact", "chain"}));
   command.add_option("--clusters-per-pass", preview.clustersPerPass, "clusters sampled per pixel and preview pass")
       ->check(CLI::Range(1, 1 << 16));
 }
@@ -124,6 +140,9 @@ RenderJobSettings RenderOptions::toSettings() const {
   else if (isGuided(s.mode))
     s.preview.slices.maxSliceSize = kGuidedSliceSize;
   s.guide = guide;
+  s.guide.learnSelection = bsdfProb == "auto";
+  s.guide.misChain = misGuide == "chain";
+  if (!s.guide.learnSelection) s.guide.bsdfProbability = std::stof(bsdfProb);
   s.guide.coneAngle = coneDegrees * 3.14159265f / 180.0f;
   s.guide.perturbationAngle = perturbDegrees * 3.14159265f / 180.0f;
   if (!sky.empty()) {

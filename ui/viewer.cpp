@@ -70,6 +70,7 @@ struct PanelSettings {
   int clusters;
   float coneDegrees;
   float bsdfProbability;
+  bool learnSelection;  // mis: learn the BSDF probability per cache point (bsdfProbability is then the start)
   float defensive;
   float uniformMutation;
   int roulette;  // index into kRoulettes
@@ -134,7 +135,8 @@ int runViewer(const ViewerOptions& options) {
     settings.height = std::max(1, settings.height);
     auto session = std::make_unique<ProgressiveSession>(scene, start, settings);
     PanelSettings panel{settings.preview.vpl.count, settings.preview.clustering.clusterBudget,
-                        settings.guide.coneAngle * 57.29578f, settings.guide.bsdfProbability, settings.guide.defensive,
+                        settings.guide.coneAngle * 57.29578f, settings.guide.bsdfProbability, settings.guide.learnSelection,
+                        settings.guide.defensive,
                         settings.guide.uniformMutation, rouletteIndex(settings.tracer.roulette)};
 
     Image image, variance;
@@ -224,11 +226,14 @@ int runViewer(const ViewerOptions& options) {
                     stats.clusterSeconds, stats.guideSeconds, stats.cachePoints);
         ImGui::Text("UI %.0f fps  discarded samples %llu  roulette %s", io.Framerate,
                     static_cast<unsigned long long>(stats.discarded), stats.rouletteWindow ? "VPL window" : settings.tracer.roulette == RouletteRule::Throughput ? "throughput" : "sqrt");
+        if (stats.mode == SamplingMode::Mis && stats.learnedBsdfProbability >= 0.0)
+          ImGui::Text("MIS BSDF probability: %.2f (mean learned over cache points)", stats.learnedBsdfProbability);
         if (ImGui::CollapsingHeader("VPLs and guide")) {
           ImGui::InputInt("VPLs", &panel.vpls, 1024, 8192);
           ImGui::InputInt("clusters per slice", &panel.clusters, 10, 100);
           ImGui::SliderFloat("cone (deg)", &panel.coneDegrees, 1.0f, 90.0f);
           ImGui::SliderFloat("MIS BSDF probability", &panel.bsdfProbability, 0.0f, 1.0f);
+          ImGui::Checkbox("learn it per cache point", &panel.learnSelection);
           ImGui::SliderFloat("defensive", &panel.defensive, 0.001f, 1.0f);
           ImGui::SliderFloat("uniform mutation", &panel.uniformMutation, 0.0f, 1.0f);
           ImGui::Combo("roulette", &panel.roulette, kRouletteNames, 4);
@@ -241,6 +246,7 @@ int runViewer(const ViewerOptions& options) {
             next.preview.clustering.clusterBudget = std::clamp(panel.clusters, 1, 1 << 16);
             next.guide.coneAngle = std::clamp(panel.coneDegrees, 1.0f, 90.0f) / 57.29578f;
             next.guide.bsdfProbability = std::clamp(panel.bsdfProbability, 0.0f, 1.0f);
+            next.guide.learnSelection = panel.learnSelection;
             next.guide.defensive = std::clamp(panel.defensive, 0.001f, 1.0f);
             next.guide.uniformMutation = std::clamp(panel.uniformMutation, 0.0f, 1.0f);
             next.tracer.roulette = kRoulettes[std::clamp(panel.roulette, 0, 3)];

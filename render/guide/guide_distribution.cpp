@@ -113,11 +113,35 @@ glm::vec3 GuideDistribution::sample(float uCell, glm::vec2 uPoint) const {
   if (choice_.empty() || uCell < defensive_) return sampleUniformSphere(uPoint);
   // Reuse uCell: it picks the cell after the defensive branch.
   const float uPick = std::min((uCell - defensive_) / (1.0f - defensive_), 0x1.fffffep-1f);
-  const int cell = int(choice_.sample(uPick));
-  // Keep the point strictly inside its cell, so that cellOf() gives the cell back.
+  return pointInCell(int(choice_.sample(uPick)), uPoint);
+}
+
+glm::vec3 GuideDistribution::sample(glm::vec2 u) const {
+  if (choice_.empty()) return sampleUniformSphere(u);
+  if (u.x < defensive_) return sampleUniformSphere({std::min(u.x / defensive_, 0x1.fffffep-1f), u.y});
+  const float ux = std::min((u.x - defensive_) / (1.0f - defensive_), 0x1.fffffep-1f);
+  // Row by its share (u.y), then the cell within the row (u.x), both from the one flattened CDF: a
+  // 2D inversion, so nearby numbers land in nearby cells and a stratified u stays stratified.
+  constexpr size_t n = kResolution;
+  const double y = std::clamp(double(u.y), 0.0, 1.0);
+  size_t lo = 0, hi = n;  // the row r with cdf(r n) <= y < cdf((r + 1) n)
+  while (hi - lo > 1) {
+    const size_t mid = (lo + hi) / 2;
+    (choice_.cdf(mid * n) <= y ? lo : hi) = mid;
+  }
+  size_t row = lo;
+  while (!(choice_.cdf((row + 1) * n) > choice_.cdf(row * n)) && row > 0) --row;  // rounding at the top
+  const double rowStart = choice_.cdf(row * n), rowMass = choice_.cdf((row + 1) * n) - rowStart;
+  const float uInRow = float(std::clamp((y - rowStart) / rowMass, 0.0, double(0x1.fffffep-1f)));
+  float uInCell = 0.0f;
+  const int cell = int(choice_.sampleRange(ux, row * n, (row + 1) * n, &uInCell));
+  return pointInCell(cell, {uInCell, uInRow});
+}
+
+glm::vec3 GuideDistribution::pointInCell(int cell, glm::vec2 u) {
   constexpr float kInside = 0x1.fffffep-1f;
-  const glm::vec2 p((float(cell % kResolution) + uPoint.x * kInside) / float(kResolution),
-                    (float(cell / kResolution) + uPoint.y * kInside) / float(kResolution));
+  const glm::vec2 p((float(cell % kResolution) + u.x * kInside) / float(kResolution),
+                    (float(cell / kResolution) + u.y * kInside) / float(kResolution));
   return equalAreaSquareToSphere(p);
 }
 

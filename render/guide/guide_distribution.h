@@ -40,6 +40,10 @@ class GuideDistribution {
   float pdf(const glm::vec3& w) const;
   // uCell picks the defensive share or a cell, uPoint the point in the cell.
   glm::vec3 sample(float uCell, glm::vec2 uPoint) const;
+  // The same density from one 2D number: u.x picks the defensive share or a cell and, rescaled within
+  // the cell's share, places the point in it with u.y. A stratified u gives stratified directions,
+  // so a guide that shares the BSDF's number (mis) keeps that number's stratification.
+  glm::vec3 sample(glm::vec2 u) const;
   glm::vec3 sample(Rng& rng) const {
     const float u = rng.uniform();
     return sample(u, rng.uniform2());
@@ -50,6 +54,8 @@ class GuideDistribution {
   float defensive() const { return defensive_; }
 
   static int cellOf(const glm::vec3& w);
+  // A point of the cell from [0,1)^2, strictly inside it, so that cellOf() gives the cell back.
+  static glm::vec3 pointInCell(int cell, glm::vec2 u);
   static glm::vec3 cellCentre(int cell);
   // Cells whose centres lie within the cone of cosine cosCone around the unit vector d: the cone
   // query (nanoflann kd-tree over the cell centres), and a brute-force scan for tests.

@@ -1,12 +1,13 @@
 #include "render/integrator/guided_continuation.h"
 
 #include <algorithm>
+#include "render/core/color.h"
 
 namespace vpl {
 
-float GuidedContinuation::bsdfProbability() const {
+float GuidedContinuation::bsdfProbability(int c) const {
   switch (mode_) {
-    case SamplingMode::Mis: return field_.settings().bsdfProbability;
+    case SamplingMode::Mis: return learner_ ? learner_->bsdfProbability(c) : field_.settings().bsdfProbability;
     case SamplingMode::Metropolis:
     case SamplingMode::Mixture: return 0.0f;
     default: return 1.0f;
@@ -39,11 +40,14 @@ int GuidedContinuation::servingCachePoint(const SurfaceHit& hit, const Bsdf& bsd
 bool GuidedContinuation::sample(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, VertexSamples& u,
                                 DirectionSample& out, PathStats& stats) {
   const int c = servingCachePoint(hit, bsdf);
-  const float pBsdf = c < 0 ? 1.0f : bsdfProbability();
+  const float pBsdf = c < 0 ? 1.0f : bsdfProbability(c);
   // The strategy is the BSDF direction's x, rescaled within the BSDF's share (as Bsdf::sample picks
   // its lobe): the BSDF's directions then stay a stratified set, which a separate strategy number
   // would thin out at random (mis gained 0.54x per sample from the stratified sampler, brdf 0.34x).
-  glm::vec2 uBsdf = pBsdf > 0.0f ? u.bsdfDirection() : glm::vec2(0.0f);
+  // mis's guide samples (unless they come from the chain) take the rest of the same number, so one
+  // stratified point serves the choice and either strategy.
+  const bool shared = mode_ == SamplingMode::Mis && !field_.settings().misChain;
+  glm::vec2 uBsdf = pBsdf > 0.0f || shared ? u.bsdfDirection() : glm::vec2(0.0f);
   if (pBsdf >= 1.0f || uBsdf.x < pBsdf) {
     if (pBsdf < 1.0f) uBsdf.x = std::min(uBsdf.x / pBsdf, 0x1.fffffep-1f);
     const auto s = bsdf.sample(wo, uBsdf);
@@ -53,12 +57,15 @@ bool GuidedContinuation::sample(const SurfaceHit& hit, const Bsdf& bsdf, const g
     if (pBsdf >= 1.0f) {  // an unguided vertex: the sample's own pdf and weight are the strategy's
       out.pdf = s->pdf;
       out.weight = s->weight;
+      if (c >= 0 && log_ && vertex_ == 1) noteFirstVertex(c, {s->pdf, field_.point(c).distribution.pdf(out.wi), s->pdf});
       return true;
     }
   } else {
     const GuideDistribution& guide = field_.point(c).distribution;
     const bool revisit = std::find(chainsUsedByPath_.begin(), chainsUsedByPath_.end(), c) != chainsUsedByPath_.end();
-    if (mode_ == SamplingMode::Mixture || revisit) {
+    if (shared) {
+      out.wi = guide.sample(glm::vec2(std::min((uBsdf.x - pBsdf) / (1.0f - pBsdf), 0x1.fffffep-1f), uBsdf.y));
+    } else if (mode_ == SamplingMode::Mixture || revisit) {
       out.wi = guide.sample(u.guideCell(), u.guidePoint());
     } else {
       // A Markov chain's states are not stratified samples: its start and mutations use the
@@ -73,16 +80,32 @@ bool GuidedContinuation::sample(const SurfaceHit& hit, const Bsdf& bsdf, const g
     }
     ++stats.guideSamples;
   }
-  out.pdf = pdf(hit, bsdf, wo, out.wi);
+  const Densities d = densities(c, bsdf, wo, out.wi);
+  noteFirstVertex(c, d);
+  out.pdf = d.mixture;
   return out.pdf > 0.0f;
+}
+
+GuidedContinuation::Densities GuidedContinuation::densities(int c, const Bsdf& bsdf, const glm::vec3& wo,
+                                                            const glm::vec3& wi) const {
+  const float pBsdf = bsdfProbability(c);
+  Densities d;
+  d.bsdf = pBsdf > 0.0f ? bsdf.pdf(wo, wi) : 0.0f;
+  d.guide = pBsdf < 1.0f ? field_.point(c).distribution.pdf(wi) : 0.0f;
+  d.mixture = pBsdf >= 1.0f ? d.bsdf : pBsdf > 0.0f ? pBsdf * d.bsdf + (1.0f - pBsdf) * d.guide : d.guide;
+  return d;
 }
 
 float GuidedContinuation::pdf(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, const glm::vec3& wi) {
   const int c = servingCachePoint(hit, bsdf);
-  if (c < 0) return bsdf.pdf(wo, wi);
-  const float pBsdf = bsdfProbability();
-  const float guidePdf = field_.point(c).distribution.pdf(wi);
-  return pBsdf > 0.0f ? pBsdf * bsdf.pdf(wo, wi) + (1.0f - pBsdf) * guidePdf : guidePdf;
+  return c < 0 ? bsdf.pdf(wo, wi) : densities(c, bsdf, wo, wi).mixture;
+}
+
+void GuidedContinuation::endPath(const glm::vec3& firstContinuation) {
+  if (first_.cachePoint < 0) return;
+  const Densities& d = first_.densities;
+  log_->add(first_.cachePoint, d.bsdf, d.guide, d.mixture, std::max(0.0f, luminance(firstContinuation)));
+  first_.cachePoint = -1;
 }
 
 }  // namespace vpl

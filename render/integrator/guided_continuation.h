@@ -3,12 +3,15 @@
 //   mixture     exact samples of the same target (representative by weight, then its cone)
 //   mis         one-sample MIS of the BSDF and the Markov chain, balance heuristic with both pdfs
 // A vertex with no cache point nearby (distance or normal test), or with a near-specular BSDF,
-// samples its BSDF. One object per
-// tile and pass: its chains restart from exact samples, so results do not depend on scheduling.
+// samples its BSDF. mis's BSDF probability is the settings' own, or with a SelectionLearner each
+// cache point's learned one; the first vertex of every path then reports to the tile's log. One
+// object per tile and pass: its chains restart from exact samples, so results do not depend on
+// scheduling.
 #pragma once
 #include <unordered_map>
 #include "render/guide/guide_field.h"
 #include "render/guide/metropolis_sampler.h"
+#include "render/guide/selection_learner.h"
 #include "render/integrator/path_tracer.h"
 #include "render/integrator/sampling_mode.h"
 
@@ -16,7 +19,9 @@ namespace vpl {
 
 class GuidedContinuation final : public ContinuationSampler {
  public:
-  GuidedContinuation(const GuideField& field, SamplingMode mode) : field_(field), mode_(mode) {}
+  GuidedContinuation(const GuideField& field, SamplingMode mode, const SelectionLearner* learner = nullptr,
+                     SelectionLearner::TileLog* log = nullptr)
+      : field_(field), mode_(mode), learner_(learner), log_(log) {}
 
   bool sample(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, VertexSamples& u, DirectionSample& out,
               PathStats& stats) override;
@@ -24,15 +29,26 @@ class GuidedContinuation final : public ContinuationSampler {
   void beginPath(uint64_t pixel) override {
     chainsUsedByPath_.clear();
     pixel_ = pixel;
+    first_.cachePoint = -1;
   }
+  void endPath(const glm::vec3& firstContinuation) override;
   void beginVertex(int depth) override {
     vertex_ = depth + 1;
     lastPosition_ = glm::vec3(NAN);  // a new vertex: look its cache point up again
   }
 
  private:
-  // Probability of drawing from the BSDF at a vertex served by a cache point.
-  float bsdfProbability() const;
+  // Probability of drawing from the BSDF at a vertex served by cache point c.
+  float bsdfProbability(int c) const;
+  // The mixture density of a direction, with its two parts for the learner.
+  struct Densities {
+    float bsdf = 0.0f, guide = 0.0f, mixture = 0.0f;
+  };
+  Densities densities(int c, const Bsdf& bsdf, const glm::vec3& wo, const glm::vec3& wi) const;
+  // Keeps the first vertex's densities until endPath() knows what its continuation brought back.
+  void noteFirstVertex(int c, const Densities& d) {
+    if (log_ && vertex_ == 1 && c >= 0) first_ = {c, d};
+  }
   // The cache point of a vertex; sample() and pdf() ask for the same vertex in a row, so remember it.
   int cachePoint(const SurfaceHit& hit);
   // The cache point that guides this vertex: none for a near-specular BSDF.
@@ -49,6 +65,12 @@ class GuidedContinuation final : public ContinuationSampler {
   int lastCachePoint_ = -1;
   uint64_t pixel_ = 0;
   int vertex_ = 0;              // the current vertex, from 1 (the camera ray's hit)
+  const SelectionLearner* learner_;
+  SelectionLearner::TileLog* log_;
+  struct {
+    int cachePoint = -1;
+    Densities densities;
+  } first_;
 };
 
 }  // namespace vpl

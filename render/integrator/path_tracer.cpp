@@ -76,6 +76,7 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
   int branchesLeft = settings_.window.maxBranches - 1;
   uint32_t nextBranchId = 1;
   float pixelEstimate = 0.0f;  // the weight window's reference, set at the camera ray's hit
+  glm::vec3 firstContinuationStart(0.0f);  // L before the first vertex's continuation
 
   Branch path{cameraRay, glm::vec3(1.0f), SurfaceHit{}, 0.0f, 0, sampler};
   for (;;) {
@@ -142,6 +143,8 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
         }
       }
 
+      if (depth == 0) firstContinuationStart = L;
+
       // The split's other branches first (each its own numbers), then this path's own continuation.
       const glm::vec3 branchBeta = beta / float(split);
       for (int b = 1; b < split; ++b) {
@@ -185,6 +188,7 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
     path = pending.back();
     pending.pop_back();
   }
+  continuation.endPath(L - firstContinuationStart);
   return L;
 }
 

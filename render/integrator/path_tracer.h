@@ -63,6 +63,10 @@ class ContinuationSampler {
   // Called at every vertex before anything is asked there; depth 0 is the camera ray's hit. A split
   // path revisits depths, so a sampler must not count vertices itself.
   virtual void beginVertex(int /*depth*/) {}
+  // Called when the camera sample is complete (all its branches traced), with the radiance its
+  // paths brought back after the first vertex's next-event estimation: the estimate of the first
+  // continuation direction, F / q (throughput is 1 there).
+  virtual void endPath(const glm::vec3& /*firstContinuation*/) {}
   // Picks a direction at this vertex from its numbers `u`; returns false when the path should end.
   virtual bool sample(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, VertexSamples& u,
                       DirectionSample& out, PathStats& stats) = 0;

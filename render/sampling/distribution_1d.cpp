@@ -23,13 +23,19 @@ Distribution1D::Distribution1D(std::span<const float> weights) {
 }
 
 size_t Distribution1D::sample(float u, float* pmf, float* uRemapped) const {
-  // First index whose upper CDF bound exceeds u; zero-weight entries have empty intervals and are skipped.
-  const double x = std::clamp(double(u), 0.0, 1.0);
-  auto it = std::upper_bound(cdf_.begin() + 1, cdf_.end(), x);
-  size_t i = it == cdf_.end() ? pmf_.size() - 1 : size_t(it - cdf_.begin()) - 1;
-  while (pmf_[i] <= 0.0f && i > 0) --i;  // only reachable through rounding at the very top
-  while (pmf_[i] <= 0.0f && i + 1 < pmf_.size()) ++i;
+  const size_t i = sampleRange(u, 0, pmf_.size(), uRemapped);
   if (pmf) *pmf = pmf_[i];
+  return i;
+}
+
+size_t Distribution1D::sampleRange(float u, size_t begin, size_t end, float* uRemapped) const {
+  // First index whose upper CDF bound exceeds the point; zero-weight entries have empty intervals and are skipped.
+  const double lo = cdf_[begin], hi = cdf_[end];
+  const double x = lo + std::clamp(double(u), 0.0, 1.0) * (hi - lo);
+  auto it = std::upper_bound(cdf_.begin() + std::ptrdiff_t(begin) + 1, cdf_.begin() + std::ptrdiff_t(end) + 1, x);
+  size_t i = it == cdf_.begin() + std::ptrdiff_t(end) + 1 ? end - 1 : size_t(it - cdf_.begin()) - 1;
+  while (pmf_[i] <= 0.0f && i > begin) --i;  // only reachable through rounding at the very top
+  while (pmf_[i] <= 0.0f && i + 1 < end) ++i;
   if (uRemapped) {
     const double width = cdf_[i + 1] - cdf_[i];
     *uRemapped = float(std::clamp(width > 0.0 ? (x - cdf_[i]) / width : 0.0, 0.0, double(0x1.fffffep-1f)));

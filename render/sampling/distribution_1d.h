@@ -21,6 +21,11 @@ class Distribution1D {
   // Never returns an index of zero weight. Must not be called when empty().
   size_t sample(float u, float* pmf = nullptr, float* uRemapped = nullptr) const;
   float pmf(size_t i) const { return i < pmf_.size() ? pmf_[i] : 0.0f; }
+  // The same within [begin, end) alone, by weight / the range's weight; the range must have weight.
+  // Ranges of a row-major grid make a 2D table (GuideDistribution: rows by the sum of their range).
+  size_t sampleRange(float u, size_t begin, size_t end, float* uRemapped = nullptr) const;
+  // Sum of the normalised weights before index i (0 at 0, 1 at size()).
+  double cdf(size_t i) const { return cdf_[i]; }
 
  private:
   std::vector<double> cdf_;  // cdf_[i] = sum of weights before i, normalised; size n + 1

@@ -56,6 +56,7 @@ struct ProgressiveSession::CameraState {
     uint64_t nextPass = 0;  // passes started (a cancelled pass still used its index)
     int complete = 0;
     WindowSwitch window;  // the auto roulette rule's decision for this film
+    std::unique_ptr<SelectionLearner> learner;  // mis: each cache point's BSDF probability, from this film's passes
   };
   std::optional<Request> key;
   Clock::time_point restart = Clock::now();
@@ -176,6 +177,7 @@ void ProgressiveSession::controllerLoop() {
       std::lock_guard lock(mutex_);
       ++stats_.restarts;
       stats_.firstPreviewSeconds = stats_.refineStartSeconds = 0.0;
+      stats_.learnedBsdfProbability = -1.0;
     }
     state.key = request;
     arena.execute([&] { runUntilChanged(state, request); });
@@ -298,7 +300,12 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
   if (isGuided(request.mode)) {
     const GuideField& guide = *state.guide;
     const SamplingMode mode = request.mode;
-    continuation = [&guide, mode](uint32_t, uint64_t) { return std::make_unique<GuidedContinuation>(guide, mode); };
+    if (mode == SamplingMode::Mis && settings_.guide.learnSelection && !mine.learner)
+      mine.learner = std::make_unique<SelectionLearner>(guide.size(), TileRenderer::tileCountFor(w, h), settings_.guide.bsdfProbability);
+    SelectionLearner* learning = mine.learner.get();
+    continuation = [&guide, mode, learning](uint32_t tile, uint64_t) {
+      return std::make_unique<GuidedContinuation>(guide, mode, learning, learning ? &learning->tileLog(tile) : nullptr);
+    };
   }
   const RouletteRule rule = settings_.tracer.roulette;
   auto refineTracer = [&]() -> const PathTracer& {
@@ -339,6 +346,11 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
     }
     if (cancelled()) return;
     ++mine.complete;
+    if (mine.learner) {
+      mine.learner->update();
+      std::lock_guard lock(mutex_);
+      stats_.learnedBsdfProbability = mine.learner->meanLearnedProbability();
+    }
     if (rule == RouletteRule::Auto && !mine.window.on() && WindowSwitch::updateDue(uint64_t(mine.complete)) &&
         mine.window.update(*mine.film)) {
       renderer.reset();

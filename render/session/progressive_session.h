@@ -64,6 +64,7 @@ struct SessionStats {
   uint64_t discarded = 0;
   uint64_t restarts = 0;
   bool rouletteWindow = false;  // the film shown uses the VPL weight window (--roulette vpl, or auto switched)
+  double learnedBsdfProbability = -1.0;  // mis: mean learned BSDF probability over cache points (-1: none yet)
 };
 
 class ProgressiveSession {

@@ -104,6 +104,7 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
   std::unique_ptr<PathTracer> tracer = vplRoulette ? windowTracer() : std::make_unique<PathTracer>(scene, settings.tracer);
   VplField field;
   GuideField guide;
+  std::optional<SelectionLearner> learner;  // mis: each cache point's BSDF probability, from the passes so far
   std::function<PixelShaderFactory(const PathTracer&)> shaderFor;
   if (settings.mode != SamplingMode::Brdf) {
     const auto t = Clock::now();
@@ -130,8 +131,13 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
       result.timings.cluster = secondsSince(t);
       result.guideBytes = guide.memoryBytes();
       const SamplingMode mode = settings.mode;
-      shaderFor = [&guide, mode](const PathTracer& t) {
-        return pathTracerShader(t, [&guide, mode](uint32_t, uint64_t) { return std::make_unique<GuidedContinuation>(guide, mode); });
+      if (mode == SamplingMode::Mis && settings.guide.learnSelection)
+        learner.emplace(guide.size(), TileRenderer::tileCountFor(settings.width, settings.height), settings.guide.bsdfProbability);
+      SelectionLearner* learning = learner ? &*learner : nullptr;
+      shaderFor = [&guide, mode, learning](const PathTracer& t) {
+        return pathTracerShader(t, [&guide, mode, learning](uint32_t tile, uint64_t) {
+          return std::make_unique<GuidedContinuation>(guide, mode, learning, learning ? &learning->tileLog(tile) : nullptr);
+        });
       };
     }
   } else {
@@ -165,6 +171,7 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
     if (timed && pass > 0 && stop.load()) break;  // cut short: not a complete pass
     ++result.spp;
     if (pass == 0) result.firstImageSeconds = secondsSince(loaded);
+    if (learner) learner->update();
     if (autoRoulette && !window.on() && WindowSwitch::updateDue(uint64_t(result.spp))) {
       if (window.update(film)) {
         result.windowFromPass = result.spp;
@@ -176,6 +183,7 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
     if (progress) progress(timed ? std::min(1.0, secondsSince(loaded) / settings.timeBudget) : double(pass + 1) / settings.spp);
   }
   watch.reset();
+  if (learner) result.learnedBsdfProbability = learner->meanLearnedProbability();
   result.timings.render = secondsSince(renderStart);
   result.seconds = secondsSince(loaded);
   result.image = film.resolve();

@@ -50,6 +50,7 @@ struct RenderJobResult {
   uint64_t proposals = 0, accepted = 0;  // Metropolis mutations
   uint64_t branches = 0;                 // extra paths grown by splitting (the vpl roulette rule)
   int windowFromPass = 0;                // the auto rule: the window's first pass (0: never used)
+  double learnedBsdfProbability = -1.0;  // mis: the mean learned BSDF probability over cache points (-1: none)
   size_t guideBytes = 0;
   std::vector<std::string> notices;
 };

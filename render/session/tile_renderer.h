@@ -48,6 +48,9 @@ class TileRenderer {
   PassStats renderPass(Film& film, uint64_t pass, const std::atomic<bool>* stop = nullptr) const;
 
   int tileCount() const { return tilesX_ * tilesY_; }
+  static int tileCountFor(int width, int height) {
+    return ((width + kTileSize - 1) / kTileSize) * ((height + kTileSize - 1) / kTileSize);
+  }
 
  private:
   Camera camera_;

@@ -43,7 +43,7 @@ RenderJobSettings settings(const std::string& scene, SamplingMode mode, int spp,
 // `batches` renders of `spp` each, seeds firstSeed, firstSeed + 1, ...; the scene is read once.
 test::BatchEstimate renderBatches(const SceneData& data, const RenderJobSettings& base, int batches, uint64_t firstSeed,
                                   uint64_t* guideSamples = nullptr, uint64_t* discarded = nullptr,
-                                  uint64_t* branches = nullptr, int* windowed = nullptr) {
+                                  uint64_t* branches = nullptr, int* windowed = nullptr, int* learned = nullptr) {
   std::vector<Image> images;
   for (int b = 0; b < batches; ++b) {
     RenderJobSettings s = base;
@@ -53,6 +53,7 @@ test::BatchEstimate renderBatches(const SceneData& data, const RenderJobSettings
     if (discarded) *discarded += r.discarded;
     if (branches) *branches += r.branches;
     if (windowed && r.windowFromPass > 0) ++*windowed;
+    if (learned && r.learnedBsdfProbability >= 0.0) ++*learned;
     images.push_back(r.image);
   }
   return test::estimateFromBatches(images);
@@ -63,13 +64,16 @@ struct Case {
   SamplingMode mode;
   int guidedVertices = GuideSettings{}.guidedVertices;  // 0: every vertex near a cache point
   RouletteRule roulette = RouletteRule::Sqrt;  // brdf, the reference, always uses it
+  // mis as Hua & Low (the Markov chain's directions), or with each cache point's BSDF probability learned.
+  enum class Mis { Default, Chain, Learned } mis = Mis::Default;
 };
 
 std::string caseName(const Case& c) {
   std::string scene = c.scene;
   scene = scene.substr(0, scene.find('.'));
   return scene + "_" + modeName(c.mode) + (c.guidedVertices == 0 ? "_every_vertex" : "") +
-         (c.roulette == RouletteRule::Vpl ? "_vpl_roulette" : c.roulette == RouletteRule::Auto ? "_auto_roulette" : "");
+         (c.roulette == RouletteRule::Vpl ? "_vpl_roulette" : c.roulette == RouletteRule::Auto ? "_auto_roulette" : "") +
+         (c.mis == Case::Mis::Chain ? "_chain" : c.mis == Case::Mis::Learned ? "_learned" : "");
 }
 
 class GuidedModes : public ::testing::TestWithParam<Case> {};
@@ -82,9 +86,13 @@ TEST_P(GuidedModes, AgreeWithBsdfSamplingPixelByPixel) {
   const test::BatchEstimate reference =
       renderBatches(data, settings(c.scene, SamplingMode::Brdf, kSpp, 0), kBatches, 1000);
   uint64_t guideSamples = 0, discarded = 0, branches = 0;
-  int windowed = 0;
-  const test::BatchEstimate guided = renderBatches(data, settings(c.scene, c.mode, kSpp, 0, c.guidedVertices, c.roulette),
-                                                   kBatches, 2000, &guideSamples, &discarded, &branches, &windowed);
+  int windowed = 0, learned = 0;
+  RenderJobSettings s = settings(c.scene, c.mode, kSpp, 0, c.guidedVertices, c.roulette);
+  s.guide.misChain = c.mis == Case::Mis::Chain;
+  s.guide.learnSelection = c.mis == Case::Mis::Learned;
+  const test::BatchEstimate guided =
+      renderBatches(data, s, kBatches, 2000, &guideSamples, &discarded, &branches, &windowed, &learned);
+  if (c.mis == Case::Mis::Learned) EXPECT_EQ(learned, kBatches) << "no cache point learned its probability";
   if (c.mode != SamplingMode::Brdf) EXPECT_GT(guideSamples, 0u) << "the guide was never used";
   if (c.roulette == RouletteRule::Vpl || c.roulette == RouletteRule::Auto) EXPECT_GT(branches, 0u) << "no path was ever split";
   if (c.roulette == RouletteRule::Auto) EXPECT_EQ(windowed, kBatches) << "the auto rule did not switch to the window";
@@ -111,7 +119,12 @@ INSTANTIATE_TEST_SUITE_P(
                       Case{"cornell_box.gltf", SamplingMode::Brdf, 1, RouletteRule::Vpl},
                       Case{"two_rooms.gltf", SamplingMode::Mis, 1, RouletteRule::Vpl},
                       Case{"cornell_glossy.gltf", SamplingMode::Metropolis, 0, RouletteRule::Vpl},
-                      Case{"door_ajar.gltf", SamplingMode::Brdf, 1, RouletteRule::Auto}),
+                      Case{"door_ajar.gltf", SamplingMode::Brdf, 1, RouletteRule::Auto},
+                      // The paper's own mis (Markov chain), and mis with learned BSDF probabilities.
+                      Case{"two_rooms.gltf", SamplingMode::Mis, 1, RouletteRule::Sqrt, Case::Mis::Chain},
+                      Case{"cornell_glossy.gltf", SamplingMode::Mis, 1, RouletteRule::Sqrt, Case::Mis::Chain},
+                      Case{"two_rooms.gltf", SamplingMode::Mis, 1, RouletteRule::Sqrt, Case::Mis::Learned},
+                      Case{"cornell_glossy.gltf", SamplingMode::Mis, 0, RouletteRule::Sqrt, Case::Mis::Learned}),
     [](const auto& info) { return caseName(info.param); });
 
 // The statistic is not blind: BSDF sampling against itself passes, and against itself 5 % brighter
