@@ -44,13 +44,25 @@ struct Builder {
       leaf(begin, end);
       return;
     }
-    // Splitting at the median position (not the spatial middle) keeps the tree balanced; identical
-    // points are simply divided in two.
+    // Split at the median value (not the spatial middle), which keeps the tree nearly balanced, and
+    // keep the points equal to it together, on whichever side balances better. Dividing them by
+    // position in the array instead cut a wall (x = 0 everywhere) or a row of a level wall (one y)
+    // into runs of rows, and a run that went with the other half joined slices of other surfaces:
+    // thin dark lines in the preview, one per run.
+    const auto less = [&](uint32_t a, uint32_t b) { return p[a][axis] < p[b][axis]; };
     const uint32_t mid = begin + (end - begin) / 2;
-    std::nth_element(order.begin() + begin, order.begin() + mid, order.begin() + end,
-                     [&](uint32_t a, uint32_t b) { return p[a][axis] < p[b][axis]; });
-    split(begin, mid);
-    split(mid, end);
+    std::nth_element(order.begin() + begin, order.begin() + mid, order.begin() + end, less);
+    const float median = p[order[mid]][axis];
+    const auto below = std::partition(order.begin() + begin, order.begin() + end,
+                                      [&](uint32_t i) { return p[i][axis] < median; });
+    const auto upTo = std::partition(below, order.begin() + end, [&](uint32_t i) { return p[i][axis] <= median; });
+    const uint32_t a = uint32_t(below - order.begin()), b = uint32_t(upTo - order.begin());
+    // The median's side: a == begin or b == end would leave one half empty. Only identical points
+    // (no extent at all) leave neither; those are divided by position, which cannot show.
+    const bool aSplits = a > begin, bSplits = b < end;
+    const uint32_t cut = !aSplits && !bSplits ? mid : aSplits && (!bSplits || (mid - a) <= (b - mid)) ? a : b;
+    split(begin, cut);
+    split(cut, end);
   }
 
   void leaf(uint32_t begin, uint32_t end) {

@@ -34,7 +34,7 @@ int GuidedContinuation::servingCachePoint(const SurfaceHit& hit, const Bsdf& bsd
   const int c = cachePoint(hit);  // always asked, so the vertex count stays right
   // A lobe a few degrees wide is found only by sampling it: no tabulated guide can (a mirror under
   // a sky came out 20x too dark in the guide-only modes before this).
-  return bsdf.isNearSpecular() ? -1 : c;
+  return c < 0 || bsdf.isNearSpecular() ? -1 : c;
 }
 
 bool GuidedContinuation::sample(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, VertexSamples& u,
