@@ -19,7 +19,7 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 for name in "$@"; do
   scene=$(scene_file "$here" "$build" "$name" equal_time)
-  ref=$(ls "$refs"/ref_"$name"_*.exr 2>/dev/null | head -1)
+  ref=$(ls "$refs"/ref_"$name"_*.exr 2>/dev/null | head -1 || true)
   [ -n "$ref" ] || { echo "equal_time: no reference ref_${name}_*.exr in $refs" >&2; exit 2; }
   size=(--width 320 --height 240)
   [ "$name" = cornell_box ] && size=(--width 256 --height 256)
