@@ -37,32 +37,26 @@ struct Builder {
         lo[k] = std::min(lo[k], p[order[i]][k]);
         hi[k] = std::max(hi[k], p[order[i]][k]);
       }
-    int axis = 0;
-    for (int k = 1; k < 6; ++k)
-      if (hi[k] - lo[k] > hi[axis] - lo[axis]) axis = k;
     if (end - begin <= maxSize) {
       leaf(begin, end);
       return;
     }
-    // Split at the median value (not the spatial middle), which keeps the tree nearly balanced, and
-    // keep the points equal to it together, on whichever side balances better. Dividing them by
-    // position in the array instead cut a wall (x = 0 everywhere) or a row of a level wall (one y)
-    // into runs of rows, and a run that went with the other half joined slices of other surfaces:
-    // thin dark lines in the preview, one per run.
-    const auto less = [&](uint32_t a, uint32_t b) { return p[a][axis] < p[b][axis]; };
+    // Split at the median position (not the spatial middle), which keeps the tree balanced. Points
+    // that tie on the axis are ordered by the other axes, widest first, so a tie group divides along
+    // a line in space. Divided by their place in the array instead, a level wall's rows (one y) or a
+    // whole wall (x = 0) were cut into runs of rows, and a run that went with the other half joined
+    // slices of other surfaces: thin dark lines in the preview, one per run.
+    std::array<int, 6> axes{0, 1, 2, 3, 4, 5};
+    std::stable_sort(axes.begin(), axes.end(), [&](int a, int b) { return hi[a] - lo[a] > hi[b] - lo[b]; });
+    const auto before = [&](uint32_t a, uint32_t b) {
+      for (int k : axes)
+        if (p[a][k] != p[b][k]) return p[a][k] < p[b][k];
+      return a < b;
+    };
     const uint32_t mid = begin + (end - begin) / 2;
-    std::nth_element(order.begin() + begin, order.begin() + mid, order.begin() + end, less);
-    const float median = p[order[mid]][axis];
-    const auto below = std::partition(order.begin() + begin, order.begin() + end,
-                                      [&](uint32_t i) { return p[i][axis] < median; });
-    const auto upTo = std::partition(below, order.begin() + end, [&](uint32_t i) { return p[i][axis] <= median; });
-    const uint32_t a = uint32_t(below - order.begin()), b = uint32_t(upTo - order.begin());
-    // The median's side: a == begin or b == end would leave one half empty. Only identical points
-    // (no extent at all) leave neither; those are divided by position, which cannot show.
-    const bool aSplits = a > begin, bSplits = b < end;
-    const uint32_t cut = !aSplits && !bSplits ? mid : aSplits && (!bSplits || (mid - a) <= (b - mid)) ? a : b;
-    split(begin, cut);
-    split(cut, end);
+    std::nth_element(order.begin() + begin, order.begin() + mid, order.begin() + end, before);
+    split(begin, mid);
+    split(mid, end);
   }
 
   void leaf(uint32_t begin, uint32_t end) {

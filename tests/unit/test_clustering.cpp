@@ -59,42 +59,71 @@ std::vector<GatherPoint> wallPoints(uint64_t seed) {
 }
 
 TEST(SliceTree, LeavesAreSeparatedAlongSplitAxes) {
-  // Median splits that keep equal values on one side give leaves whose closed 6D boxes hold no point
-  // of another leaf: a brute-force test of the partition. Points on a split value once went to either
-  // side by their place in the array: on a level wall (the second set), runs of rows then joined
-  // another surface's slices, and the preview drew each run as a thin dark line.
-  for (const bool wall : {false, true}) {
-    const auto points = wall ? wallPoints(5) : randomPoints(3000, 5);
-    SliceSettings settings;
-    settings.maxSliceSize = 64;
-    const SliceTree tree = buildSliceTree(points, settings, 7.0f);
-    auto embed = [&](uint32_t i) {
-      const auto& g = points[i];
-      return std::array<float, 6>{g.position.x, g.position.y, g.position.z, g.normal.x * tree.normalScale,
-                                  g.normal.y * tree.normalScale, g.normal.z * tree.normalScale};
-    };
-    std::vector<std::array<float, 6>> lo(tree.slices.size()), hi(tree.slices.size());
+  // Median splits give leaves whose 6D boxes overlap only on ties: check that for random points no
+  // point lies strictly inside another leaf's box on every axis (a brute-force test of the partition).
+  const auto points = randomPoints(3000, 5);
+  SliceSettings settings;
+  settings.maxSliceSize = 64;
+  const SliceTree tree = buildSliceTree(points, settings, 7.0f);
+  auto embed = [&](uint32_t i) {
+    const auto& g = points[i];
+    return std::array<float, 6>{g.position.x, g.position.y, g.position.z, g.normal.x * tree.normalScale,
+                                g.normal.y * tree.normalScale, g.normal.z * tree.normalScale};
+  };
+  std::vector<std::array<float, 6>> lo(tree.slices.size()), hi(tree.slices.size());
+  for (size_t s = 0; s < tree.slices.size(); ++s) {
+    lo[s].fill(INFINITY);
+    hi[s].fill(-INFINITY);
+    for (uint32_t i = tree.slices[s].begin; i < tree.slices[s].end; ++i) {
+      const auto e = embed(tree.order[i]);
+      for (int k = 0; k < 6; ++k) {
+        lo[s][k] = std::min(lo[s][k], e[k]);
+        hi[s][k] = std::max(hi[s][k], e[k]);
+      }
+    }
+  }
+  for (uint32_t i = 0; i < points.size(); ++i) {
+    const auto e = embed(i);
     for (size_t s = 0; s < tree.slices.size(); ++s) {
-      lo[s].fill(INFINITY);
-      hi[s].fill(-INFINITY);
-      for (uint32_t i = tree.slices[s].begin; i < tree.slices[s].end; ++i) {
-        const auto e = embed(tree.order[i]);
-        for (int k = 0; k < 6; ++k) {
-          lo[s][k] = std::min(lo[s][k], e[k]);
-          hi[s][k] = std::max(hi[s][k], e[k]);
-        }
-      }
+      if (s == tree.sliceOf[i]) continue;
+      bool strictlyInside = true;
+      for (int k = 0; k < 6; ++k) strictlyInside &= e[k] > lo[s][k] && e[k] < hi[s][k];
+      ASSERT_FALSE(strictlyInside) << "point " << i << " inside the box of slice " << s;
     }
-    for (uint32_t i = 0; i < points.size(); ++i) {
-      const auto e = embed(i);
-      for (size_t s = 0; s < tree.slices.size(); ++s) {
-        if (s == tree.sliceOf[i]) continue;
-        bool inside = true;
-        for (int k = 0; k < 6; ++k) inside &= e[k] >= lo[s][k] && e[k] <= hi[s][k];
-        ASSERT_FALSE(inside) << (wall ? "wall" : "random") << " point " << i << " inside the box of slice " << s;
-      }
+  }
+  EXPECT_NEAR(tree.normalScale, 7.0f / 16.0f, 1e-6f);
+}
+
+// Points that tie on a split axis, as a camera sees a level wall (one plane x = 0, one normal, rows of
+// one height), must divide along a line of the wall, not by their place in the array: divided that
+// way, runs of rows joined the slices of other surfaces and the preview drew each run as a thin dark
+// line. On the wall's own coordinates (y, z), no wall point may lie strictly inside the box of
+// another slice's wall points.
+TEST(SliceTree, TiedPointsOfAWallDivideAlongALine) {
+  std::vector<GatherPoint> points = randomPoints(1500, 5);  // the rest of the room
+  const size_t firstWall = points.size();
+  for (int row = 0; row < 40; ++row)
+    for (int column = 0; column < 60; ++column) {
+      GatherPoint g;
+      g.position = glm::vec3(0.0f, 0.05f * float(row), 0.05f * float(column));
+      g.normal = glm::vec3(1, 0, 0);
+      points.push_back(g);
     }
-    EXPECT_NEAR(tree.normalScale, 7.0f / 16.0f, 1e-6f);
+  SliceSettings settings;
+  settings.maxSliceSize = 64;
+  const SliceTree tree = buildSliceTree(points, settings, 7.0f);
+  std::vector<glm::vec2> lo(tree.slices.size(), glm::vec2(INFINITY)), hi(tree.slices.size(), glm::vec2(-INFINITY));
+  for (size_t i = firstWall; i < points.size(); ++i) {
+    const glm::vec2 yz(points[i].position.y, points[i].position.z);
+    lo[tree.sliceOf[i]] = glm::min(lo[tree.sliceOf[i]], yz);
+    hi[tree.sliceOf[i]] = glm::max(hi[tree.sliceOf[i]], yz);
+  }
+  for (size_t i = firstWall; i < points.size(); ++i) {
+    const glm::vec2 yz(points[i].position.y, points[i].position.z);
+    for (size_t s = 0; s < tree.slices.size(); ++s)
+      if (s != tree.sliceOf[i])
+        ASSERT_FALSE(yz.x > lo[s].x && yz.x < hi[s].x && yz.y > lo[s].y && yz.y < hi[s].y)
+            << "wall point " << i - firstWall << " inside the wall part of slice " << s;
   }
 }
 
