@@ -14,3 +14,18 @@ scene_file() {
 
 # A scene's content hash (its .bin too, when there is one): the key of cached references.
 scene_hash() { local bin=${1%.*}.bin; cat "$1" $([ -f "$bin" ] && echo "$bin") | sha1sum | cut -c1-10; }
+
+# The path of a scene's converged brdf reference (`vplview reference`), made on first use and cached in
+# OUT as ref_NAME_HASH_WxH_SPPspp_dDEPTH.exr, so that a changed scene never reuses an old one.
+# Usage: ref=$(cached_reference EXE SCENE_FILE NAME OUT W H SPP DEPTH THREADS); progress goes to stderr.
+cached_reference() {
+  local exe=$1 scene=$2 name=$3 out=$4 w=$5 h=$6 spp=$7 depth=$8 threads=$9
+  local ref=$out/ref_${name}_$(scene_hash "$scene")_${w}x${h}_${spp}spp_d${depth}.exr
+  if [ ! -f "$ref" ]; then
+    echo "$(date -Is) $name: reference, $spp spp, depth $depth (cached as $(basename "$ref"))" >&2
+    "$exe" reference "$scene" --spp "$spp" --width "$w" --height "$h" --threads "$threads" --max-depth "$depth" \
+      --out "$ref.tmp.exr" >/dev/null
+    mv "$ref.tmp.exr" "$ref"
+  fi
+  echo "$ref"
+}

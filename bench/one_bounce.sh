@@ -27,13 +27,7 @@ echo "scene,mode,seed,spp,seconds,relmse" > "$csv"
 
 for name in $SCENES; do
   scene=$(scene_file "$here" "$build" "$name" one_bounce)
-  hash=$(scene_hash "$scene")
-  ref=$out/ref_${name}_${hash}_${W}x${H}_${REF_SPP}spp_d2.exr
-  if [ ! -f "$ref" ]; then
-    echo "$(date -Is) $name: reference, $REF_SPP spp, depth 2" >&2
-    "$exe" reference "$scene" --spp "$REF_SPP" --width $W --height $H --threads 0 --max-depth 2 --out "$ref.tmp.exr" >/dev/null
-    mv "$ref.tmp.exr" "$ref"
-  fi
+  ref=$(cached_reference "$exe" "$scene" "$name" "$out" $W $H "$REF_SPP" 2 0)
   for seed in $SEEDS; do
     for mode in brdf metropolis mis; do
       img=$out/${name}_${mode}_seed$seed.exr

@@ -30,13 +30,7 @@ echo "scene,mode,rule,start,seed,budget,spp,relmse" > "$csv"
 for name in $SCENES; do
   scene=$(scene_file "$here" "$build" "$name" roulette)
   if [ -n "${SIZE:-}" ]; then read -r W H <<<"$SIZE"; elif [ "$name" = cornell_box ]; then W=256 H=256; else W=320 H=240; fi
-  hash=$(scene_hash "$scene")
-  ref=$out/ref_${name}_${hash}_${W}x${H}_${REF_SPP}spp_d32.exr
-  if [ ! -f "$ref" ]; then
-    echo "$(date -Is) $name: reference, $REF_SPP spp" >&2
-    "$exe" reference "$scene" --spp "$REF_SPP" --width $W --height $H --threads 0 --out "$ref.tmp.exr" >/dev/null
-    mv "$ref.tmp.exr" "$ref"
-  fi
+  ref=$(cached_reference "$exe" "$scene" "$name" "$out" $W $H "$REF_SPP" 32 0)
   for mode in $MODES; do
     for seed in $SEEDS; do
       for v in $VARIANTS; do

@@ -95,15 +95,8 @@ if p <= 0.0 or a - 16 * p < 0.0: p = b / 64   # noise: no fixed part
 print(p, max(a - 16 * p, 0.0))" "${probe[@]}")
   echo "$name ${W}x$H: Cycles probes at 16 and 64 spp: ${probe[*]} s -> $per_spp s/spp + $fixed s" | tee -a "$log"
 
-  hash=$(scene_hash "$scene")
   rspp=$(ref_spp_of "$name")
-  ref=$out/ref_${name}_${hash}_${W}x${H}_${rspp}spp_d${MAX_DEPTH}.exr
-  if [ ! -f "$ref" ]; then
-    echo "$(date -Is) $name: reference, $rspp spp (cached as $(basename "$ref"))" | tee -a "$log"
-    "$exe" reference "$scene" --spp "$rspp" --width "$W" --height "$H" --threads "$REF_THREADS" \
-        --max-depth "$MAX_DEPTH" --out "$ref.tmp.exr" | tail -1 >> "$log"
-    mv "$ref.tmp.exr" "$ref"
-  fi
+  ref=$(cached_reference "$exe" "$scene" "$name" "$out" "$W" "$H" "$rspp" "$MAX_DEPTH" "$REF_THREADS" 2>> "$log")
 
   for t in $budgets; do
     cspp=$(python3 -c "import sys; t, f, p = map(float, sys.argv[1:]); print(max(1, round((t - f) / p)))" "$t" "$fixed" "$per_spp")

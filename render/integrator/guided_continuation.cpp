@@ -57,7 +57,7 @@ bool GuidedContinuation::sample(const SurfaceHit& hit, const Bsdf& bsdf, const g
     if (pBsdf >= 1.0f) {  // an unguided vertex: the sample's own pdf and weight are the strategy's
       out.pdf = s->pdf;
       out.weight = s->weight;
-      if (c >= 0 && log_ && vertex_ == 1) noteFirstVertex(c, {s->pdf, field_.point(c).distribution.pdf(out.wi), s->pdf});
+      if (learnsAt(c)) noteFirstVertex(c, {s->pdf, field_.point(c).distribution.pdf(out.wi), s->pdf});
       return true;
     }
   } else {
@@ -81,7 +81,7 @@ bool GuidedContinuation::sample(const SurfaceHit& hit, const Bsdf& bsdf, const g
     ++stats.guideSamples;
   }
   const Densities d = densities(c, bsdf, wo, out.wi);
-  noteFirstVertex(c, d);
+  if (learnsAt(c)) noteFirstVertex(c, d);
   out.pdf = d.mixture;
   return out.pdf > 0.0f;
 }

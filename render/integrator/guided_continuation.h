@@ -45,10 +45,10 @@ class GuidedContinuation final : public ContinuationSampler {
     float bsdf = 0.0f, guide = 0.0f, mixture = 0.0f;
   };
   Densities densities(int c, const Bsdf& bsdf, const glm::vec3& wo, const glm::vec3& wi) const;
+  // Whether this vertex reports to the learner: the first of its path, served by cache point c.
+  bool learnsAt(int c) const { return log_ && vertex_ == 1 && c >= 0; }
   // Keeps the first vertex's densities until endPath() knows what its continuation brought back.
-  void noteFirstVertex(int c, const Densities& d) {
-    if (log_ && vertex_ == 1 && c >= 0) first_ = {c, d};
-  }
+  void noteFirstVertex(int c, const Densities& d) { first_ = {c, d}; }
   // The cache point of a vertex; sample() and pdf() ask for the same vertex in a row, so remember it.
   int cachePoint(const SurfaceHit& hit);
   // The cache point that guides this vertex: none for a near-specular BSDF.

@@ -302,10 +302,7 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
     const SamplingMode mode = request.mode;
     if (mode == SamplingMode::Mis && settings_.guide.learnSelection && !mine.learner)
       mine.learner = std::make_unique<SelectionLearner>(guide.size(), TileRenderer::tileCountFor(w, h), settings_.guide.bsdfProbability);
-    SelectionLearner* learning = mine.learner.get();
-    continuation = [&guide, mode, learning](uint32_t tile, uint64_t) {
-      return std::make_unique<GuidedContinuation>(guide, mode, learning, learning ? &learning->tileLog(tile) : nullptr);
-    };
+    continuation = guidedContinuations(guide, mode, mine.learner.get());
   }
   const RouletteRule rule = settings_.tracer.roulette;
   auto refineTracer = [&]() -> const PathTracer& {

@@ -133,12 +133,8 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
       const SamplingMode mode = settings.mode;
       if (mode == SamplingMode::Mis && settings.guide.learnSelection)
         learner.emplace(guide.size(), TileRenderer::tileCountFor(settings.width, settings.height), settings.guide.bsdfProbability);
-      SelectionLearner* learning = learner ? &*learner : nullptr;
-      shaderFor = [&guide, mode, learning](const PathTracer& t) {
-        return pathTracerShader(t, [&guide, mode, learning](uint32_t tile, uint64_t) {
-          return std::make_unique<GuidedContinuation>(guide, mode, learning, learning ? &learning->tileLog(tile) : nullptr);
-        });
-      };
+      const ContinuationFactory continuation = guidedContinuations(guide, mode, learner ? &*learner : nullptr);
+      shaderFor = [continuation](const PathTracer& t) { return pathTracerShader(t, continuation); };
     }
   } else {
     shaderFor = [](const PathTracer& t) { return pathTracerShader(t); };

@@ -3,6 +3,7 @@
 #include <tbb/combinable.h>
 #include <tbb/parallel_for.h>
 #include "render/core/color.h"
+#include "render/integrator/guided_continuation.h"
 
 namespace vpl {
 
@@ -13,6 +14,12 @@ PixelShaderFactory pathTracerShader(const PathTracer& tracer, ContinuationFactor
     return [&tracer, strategy](const Ray& ray, uint64_t pixel, PixelSampler& sampler, PathStats& stats) {
       return tracer.radiance(ray, sampler, *strategy, stats, pixel);
     };
+  };
+}
+
+ContinuationFactory guidedContinuations(const GuideField& guide, SamplingMode mode, SelectionLearner* learner) {
+  return [&guide, mode, learner](uint32_t tile, uint64_t) {
+    return std::make_unique<GuidedContinuation>(guide, mode, learner, learner ? &learner->tileLog(tile) : nullptr);
   };
 }
 

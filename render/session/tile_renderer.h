@@ -9,9 +9,13 @@
 #include <memory>
 #include "render/film/film.h"
 #include "render/integrator/path_tracer.h"
+#include "render/integrator/sampling_mode.h"
 #include "render/scene/camera.h"
 
 namespace vpl {
+
+class GuideField;
+class SelectionLearner;
 
 struct PassStats {
   uint64_t rays = 0;
@@ -37,6 +41,9 @@ using PixelShaderFactory = std::function<PixelShader(uint32_t tileIndex, uint64_
 // The path tracer as a pixel shader, with a continuation strategy per tile (nullptr: BSDF sampling).
 using ContinuationFactory = std::function<std::unique_ptr<ContinuationSampler>(uint32_t tileIndex, uint64_t pass)>;
 PixelShaderFactory pathTracerShader(const PathTracer& tracer, ContinuationFactory continuation = nullptr);
+// The guided modes' continuations: one per tile and pass, each writing its tile's log of `learner`
+// (mis with a learned BSDF probability; nullptr: none).
+ContinuationFactory guidedContinuations(const GuideField& guide, SamplingMode mode, SelectionLearner* learner);
 
 class TileRenderer {
  public:
