@@ -1,6 +1,7 @@
 #include "render/vpl/irradiance_grid.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include "render/core/color.h"
 #include "render/sampling/rng.h"
@@ -10,8 +11,11 @@ namespace vpl {
 
 namespace {
 
-constexpr int kCoordBits = 19;
+// Coordinates count finest cells from the bounds' corner: at most kFinestCells across the diagonal,
+// so 8 bits hold them, and a key (valid bit, level, side, three coordinates) fits in 32 bits.
+constexpr int kCoordBits = 8;
 constexpr uint32_t kCoordMax = (1u << kCoordBits) - 1u;
+static_assert(IrradianceGrid::kFinestCells <= int(kCoordMax));
 
 // Signed dominant axis of n: 0..5 for +x, -x, +y, -y, +z, -z.
 uint32_t bucketOf(const glm::vec3& n) {
@@ -20,26 +24,24 @@ uint32_t bucketOf(const glm::vec3& n) {
   return 2u * axis + (n[int(axis)] < 0.0f ? 1u : 0u);
 }
 
-uint64_t packKey(int level, uint32_t bucket, glm::uvec3 c) {
-  return (1ull << 63) | uint64_t(level) << 60 | uint64_t(bucket) << 57 | uint64_t(c.x) << 38 | uint64_t(c.y) << 19 | uint64_t(c.z);
+uint32_t packKey(int level, uint32_t bucket, glm::uvec3 c) {
+  return 1u << 31 | uint32_t(level) << 27 | bucket << 24 | c.x << 16 | c.y << 8 | c.z;
 }
-glm::uvec3 coordsOf(uint64_t key) {
-  return {uint32_t(key >> 38) & kCoordMax, uint32_t(key >> 19) & kCoordMax, uint32_t(key) & kCoordMax};
-}
-int levelOf(uint64_t key) { return int(key >> 60) & 7; }
-uint32_t bucketOfKey(uint64_t key) { return uint32_t(key >> 57) & 7u; }
+glm::uvec3 coordsOf(uint32_t key) { return {(key >> 16) & kCoordMax, (key >> 8) & kCoordMax, key & kCoordMax}; }
+int levelOf(uint32_t key) { return int(key >> 27) & 7; }
+uint32_t bucketOfKey(uint32_t key) { return (key >> 24) & 7u; }
 
-size_t slotHash(uint64_t key) { return size_t(mix64(key)); }
+size_t slotHash(uint32_t key) { return size_t(mix64(key)); }
 
 }  // namespace
 
-uint64_t IrradianceGrid::keyOf(const glm::vec3& p, const glm::vec3& n, int level) const {
+uint32_t IrradianceGrid::keyOf(const glm::vec3& p, const glm::vec3& n, int level) const {
   const glm::vec3 c = glm::floor((p - origin_) / (finestSize_ * float(1 << level)));
   const glm::vec3 clamped = glm::clamp(c, glm::vec3(0.0f), glm::vec3(float(kCoordMax)));
   return packKey(level, bucketOf(n), glm::uvec3(clamped));
 }
 
-int32_t IrradianceGrid::find(uint64_t key) const {
+int32_t IrradianceGrid::find(uint32_t key) const {
   if (keys_.empty()) return -1;
   const size_t mask = keys_.size() - 1;
   for (size_t i = slotHash(key) & mask;; i = (i + 1) & mask) {
@@ -48,9 +50,9 @@ int32_t IrradianceGrid::find(uint64_t key) const {
   }
 }
 
-IrradianceGrid::Cell& IrradianceGrid::insert(uint64_t key) {
+IrradianceGrid::Cell& IrradianceGrid::insert(uint32_t key) {
   if (2 * (cells_.size() + 1) > keys_.size()) {  // keep the table at most half full
-    std::vector<uint64_t> keys(std::max<size_t>(64, 2 * keys_.size()), 0);
+    std::vector<uint32_t> keys(std::max<size_t>(64, 2 * keys_.size()), 0);
     std::vector<int32_t> slots(keys.size(), -1);
     for (size_t j = 0; j < keys_.size(); ++j) {
       if (keys_[j] == 0) continue;
@@ -150,33 +152,51 @@ IrradianceGrid::IrradianceGrid(const RenderScene& scene, int photons, uint64_t s
   // Resolve from the coarsest level down: a cell keeps its own estimate when its parent's VPLs,
   // shared out by area, promise it enough; else it takes its parent's. Deciding by its own count
   // would pick the cells whose count happened to come out high, and bias the estimate up.
-  resolved_.assign(cells_.size(), glm::vec3(0.0f));
+  std::vector<glm::vec3> resolved(cells_.size(), glm::vec3(0.0f));
   for (size_t cell = cells_.size(); cell-- > 0;) {  // coarsest first: levels were made in order
     const Cell& c = cells_[cell];
     const int level = levelOf(c.key);
     const glm::vec3 own = c.area > 0.0f ? c.flux / c.area : glm::vec3(0.0f);
     const int32_t parent = level + 1 < kLevels ? find(packKey(level + 1, bucketOfKey(c.key), coordsOf(c.key) / 2u)) : -1;
     if (parent < 0) {
-      resolved_[cell] = own;
+      resolved[cell] = own;
       continue;
     }
     const Cell& p = cells_[size_t(parent)];
     const float promised = p.area > 0.0f ? float(p.vpls) * c.area / p.area : 0.0f;
-    resolved_[cell] = promised >= float(kMinVpls) ? own : resolved_[size_t(parent)];
+    resolved[cell] = promised >= float(kMinVpls) ? own : resolved[size_t(parent)];
   }
+  // Filled to at most 2/3 (a hit rarely probes past its cache line).
+  resolved_.assign(std::bit_ceil(std::max<size_t>(64, 3 * cells_.size() / 2)), Resolved{});
+  for (size_t c = 0; c < cells_.size(); ++c) {
+    const size_t mask = resolved_.size() - 1;
+    size_t i = slotHash(cells_[c].key) & mask;
+    while (resolved_[i].key != 0) i = (i + 1) & mask;
+    resolved_[i] = {cells_[c].key, resolved[c]};
+  }
+  // The construction's tables are not needed by lookups.
+  cellCount_ = cells_.size();
+  keys_ = {};
+  slots_ = {};
+  cells_ = {};
 }
 
 glm::vec3 IrradianceGrid::irradiance(const glm::vec3& p, const glm::vec3& n) const {
+  if (resolved_.empty()) return glm::vec3(0.0f);
+  const size_t mask = resolved_.size() - 1;
   for (int level = 0; level < kLevels; ++level) {
-    const int32_t i = find(keyOf(p, n, level));
-    if (i >= 0) return resolved_[size_t(i)];
+    const uint32_t key = keyOf(p, n, level);
+    for (size_t i = slotHash(key) & mask;; i = (i + 1) & mask) {
+      if (resolved_[i].key == key) return resolved_[i].irradiance;
+      if (resolved_[i].key == 0) break;
+    }
   }
   return glm::vec3(0.0f);
 }
 
 size_t IrradianceGrid::memoryBytes() const {
-  return keys_.capacity() * sizeof(uint64_t) + slots_.capacity() * sizeof(int32_t) + cells_.capacity() * sizeof(Cell) +
-         resolved_.capacity() * sizeof(glm::vec3);
+  return keys_.capacity() * sizeof(uint32_t) + slots_.capacity() * sizeof(int32_t) + cells_.capacity() * sizeof(Cell) +
+         resolved_.capacity() * sizeof(Resolved);
 }
 
 }  // namespace vpl
