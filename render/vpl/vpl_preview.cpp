@@ -28,6 +28,16 @@ bool vplVisible(const RenderScene& scene, const SurfaceHit& at, const Vpl& light
   return !scene.accel().occluded(spawnShadowRay(at, wi, dist));
 }
 
+// A point light's transport to x facing n without visibility or BSDFs: both cosines over the
+// clamped squared distance (the diffuse part of vplContribution, up to the albedos).
+float unoccludedTransport(const glm::vec3& light, const glm::vec3& lightNormal, const glm::vec3& x, const glm::vec3& n,
+                          float minDistance) {
+  const glm::vec3 d = light - x;
+  const float d2 = glm::dot(d, d);
+  const float cosLight = std::max(0.0f, -glm::dot(lightNormal, d)), cosHere = std::max(0.0f, glm::dot(n, d));
+  return cosLight * cosHere / std::max(d2 * std::max(d2, minDistance * minDistance), 1e-30f);
+}
+
 // The light matrix entries LightSlice samples: VPL j seen from slice i's representative.
 class SliceTransport final : public LightTransport {
  public:
@@ -163,6 +173,7 @@ VplField buildVplField(const RenderScene& scene, const Camera& camera, std::shar
   // Which cluster a preview pass samples: by estimated contribution, with a defensive share so that
   // clusters whose representative is hidden from the slice's centre still get sampled elsewhere in it.
   field.clusterChoice.resize(field.clusters.slices.size());
+  field.clusterPoints.resize(field.clusters.slices.size());
   for (size_t s = 0; s < field.clusters.slices.size(); ++s) {
     const auto& clusters = field.clusters.slices[s].clusters;
     std::vector<float> w(clusters.size());
@@ -172,6 +183,31 @@ VplField buildVplField(const RenderScene& scene, const Camera& camera, std::shar
     for (size_t c = 0; c < clusters.size(); ++c)
       w[c] = mean > 0.0f ? clusters[c].estimate + 0.1f * mean : clusters[c].totalPower;
     field.clusterChoice[s] = Distribution1D(w);
+
+    // Each cluster's weight is its estimate at the slice representative over its unoccluded
+    // transport there, so that a pixel's weight (times the transport to its own hit) is the estimate
+    // moved from the centre to the pixel: visibility, albedos and glossy lobes as seen at the centre.
+    // A cluster the centre faces away from (a column's far side) takes the slice's mean ratio.
+    ClusterPoints& points = field.clusterPoints[s];
+    const SurfaceHit& centre = field.gather.hits[field.tree.slices[s].representative];
+    std::vector<float> transport(clusters.size());
+    double estimates = 0.0, unoccluded = 0.0;
+    for (size_t c = 0; c < clusters.size(); ++c) {
+      const Vpl& light = field.vpls->vpls[clusters[c].representative];
+      transport[c] = unoccludedTransport(light.position, light.normal, centre.position, centre.shadingNormal, field.minDistance);
+      if (transport[c] > 0.0f) {
+        estimates += clusters[c].estimate;
+        unoccluded += double(clusters[c].totalPower) * transport[c];
+      }
+    }
+    const float meanRatio = unoccluded > 0.0 ? float(estimates / unoccluded) : 0.0f;
+    for (size_t c = 0; c < clusters.size(); ++c) {
+      const Vpl& light = field.vpls->vpls[clusters[c].representative];
+      points.px.push_back(light.position.x), points.py.push_back(light.position.y), points.pz.push_back(light.position.z);
+      points.nx.push_back(light.normal.x), points.ny.push_back(light.normal.y), points.nz.push_back(light.normal.z);
+      const float w = transport[c] > 0.0f ? clusters[c].estimate / transport[c] : meanRatio * clusters[c].totalPower;
+      points.weight.push_back(std::isfinite(w) ? w : 0.0f);
+    }
   }
   return field;
 }
@@ -199,20 +235,45 @@ PixelShaderFactory previewShader(const RenderScene& scene, const VplField& field
       const Distribution1D& choice = field.clusterChoice[s];
       if (choice.empty()) return L;
       const auto& clusters = field.clusters.slices[s].clusters;
-      // Systematic sampling: the m picks sit at (i + u) / m of the choice's CDF, one in each m-th of
-      // it. Each pick alone is distributed by the choice (so the sum stays unbiased), and u itself
-      // is stratified across passes.
+      // Each cluster's probability: half the slice's choice, half its estimate moved to this very hit
+      // (ClusterPoints). A cluster close to the hit but far from the slice's centre was otherwise a
+      // rare, bright draw: a sparkle.
+      const ClusterPoints& points = field.clusterPoints[s];
+      static thread_local std::vector<float> pmf;
+      pmf.resize(points.size());
+      const glm::vec3 x = surface.position, n = surface.shadingNormal;
+      const float clamp2 = field.minDistance * field.minDistance;
+      float total = 0.0f;
+      for (size_t c = 0; c < points.size(); ++c) {
+        const float dx = points.px[c] - x.x, dy = points.py[c] - x.y, dz = points.pz[c] - x.z;
+        const float d2 = dx * dx + dy * dy + dz * dz;
+        const float cosLight = std::max(0.0f, -(points.nx[c] * dx + points.ny[c] * dy + points.nz[c] * dz));
+        const float cosHere = std::max(0.0f, n.x * dx + n.y * dy + n.z * dz);
+        pmf[c] = points.weight[c] * cosLight * cosHere / std::max(d2 * std::max(d2, clamp2), 1e-30f);
+        total += pmf[c];
+      }
+      const float own = total > 0.0f && std::isfinite(total) ? 0.5f / total : 0.0f;
+      const float shared = own > 0.0f ? 0.5f : 1.0f;
+      for (size_t c = 0; c < points.size(); ++c) pmf[c] = pmf[c] * own + shared * choice.pmf(c);
+      // Systematic sampling: the m picks sit at (i + u) / m of the CDF, one in each m-th of it. Each
+      // pick alone is distributed by the pmf (so the sum stays unbiased), and u itself is
+      // stratified across passes. One sweep of the CDF serves the m sorted picks.
       const float u = choices.x;
+      size_t c = 0;
+      float below = 0.0f;  // the CDF before cluster c
       for (int i = 0; i < m; ++i) {
-        float pmf = 0.0f;
-        const VplCluster& c = clusters[choice.sample((float(i) + u) / float(m), &pmf)];
-        const Vpl& light = field.vpls->vpls[c.representative];
+        const float target = (float(i) + u) / float(m);
+        while (c + 1 < points.size() && (below + pmf[c] <= target || pmf[c] <= 0.0f)) below += pmf[c++];
+        while (c > 0 && !(pmf[c] > 0.0f)) below -= pmf[--c];  // rounding left the target past the last weight
+        if (!(pmf[c] > 0.0f)) continue;
+        const VplCluster& cluster = clusters[c];
+        const Vpl& light = field.vpls->vpls[cluster.representative];
         const float repPower = light.power();
         if (!(repPower > 0.0f)) continue;
         const glm::vec3 contribution =
-            vplContribution(light, surface.position, bsdf, wo, field.minDistance) * (c.totalPower / repPower);
+            vplContribution(light, surface.position, bsdf, wo, field.minDistance) * (cluster.totalPower / repPower);
         if (isBlack(contribution)) continue;
-        if (vplVisible(scene, surface, light, &stats)) L += contribution / (float(m) * pmf);
+        if (vplVisible(scene, surface, light, &stats)) L += contribution / (float(m) * pmf[c]);
       }
       return L;
     };

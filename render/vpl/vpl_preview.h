@@ -1,8 +1,8 @@
 // The instant-radiosity preview (DESIGN.md §2 steps 2–5): VPLs, slices of gather points, LightSlice
 // clusters per slice, and a pixel shader that adds direct light (emitter sampling) to the indirect
 // light of the pixel's slice clusters. Each pass draws a few clusters per pixel in proportion to
-// their estimated contribution, so passes average to the full clustered sum: a coarse image at once,
-// sharper with every pass.
+// their estimated contribution (half as the slice's centre sees them, half moved to the pixel's own
+// hit), so passes average to the full clustered sum: a coarse image at once, sharper with every pass.
 //
 // Parameters (PreviewSettings):
 //   vpl.count            int    16384  VPLs (see VplSettings)
@@ -34,6 +34,15 @@ struct PreviewSettings {
   std::string validate() const;
 };
 
+// A slice's clusters as point lights (their representatives' positions and normals) in arrays a
+// pixel sweeps: a pass weighs every cluster by its unoccluded transport to the pixel's own hit, so
+// that a cluster next to that hit is drawn as often as it matters there, not as at the slice's centre.
+struct ClusterPoints {
+  std::vector<float> px, py, pz, nx, ny, nz;
+  std::vector<float> weight;  // the cluster's estimate at the slice representative / its unoccluded transport there
+  size_t size() const { return px.size(); }
+};
+
 // Everything the preview and the guide build for one camera (VPLs are the camera-independent part).
 struct VplField {
   std::shared_ptr<const VplSet> vpls;
@@ -41,6 +50,7 @@ struct VplField {
   SliceTree tree;
   LightSliceResult clusters;
   std::vector<Distribution1D> clusterChoice;  // per slice: which cluster a pass samples
+  std::vector<ClusterPoints> clusterPoints;   // per slice: its clusters as points, for each pixel's own choice
   float minDistance = 0.0f;                   // geometry-term clamp distance (world units)
   uint64_t rays = 0;
   double gatherSeconds = 0.0, sliceSeconds = 0.0;  // wall time of those stages (LightSlice's are in `clusters`)
