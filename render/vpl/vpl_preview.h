@@ -1,8 +1,7 @@
 // The instant-radiosity preview (DESIGN.md §2 steps 2–5): VPLs, slices of gather points, LightSlice
 // clusters per slice, and a pixel shader that adds direct light (emitter sampling) to the indirect
 // light of the pixel's slice clusters. Each pass draws a few clusters per pixel in proportion to
-// their estimated contribution (half as the slice's centre sees them, half moved to the pixel's own
-// hit), so passes average to the full clustered sum: a coarse image at once, sharper with every pass.
+// their estimated contribution (mostly moved from the slice's centre to the pixel's own hit), so passes average to the full clustered sum: a coarse image at once, sharper with every pass.
 //
 // Parameters (PreviewSettings):
 //   vpl.count            int    16384  VPLs (see VplSettings)
@@ -39,7 +38,7 @@ struct PreviewSettings {
 // that a cluster next to that hit is drawn as often as it matters there, not as at the slice's centre.
 struct ClusterPoints {
   std::vector<float> px, py, pz, nx, ny, nz;
-  std::vector<float> weight;  // the cluster's estimate at the slice representative / its unoccluded transport there
+  std::vector<float> weight;  // (visible estimate + unoccluded share) / unoccluded transport, at the slice representative
   size_t size() const { return px.size(); }
 };
 
