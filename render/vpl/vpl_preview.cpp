@@ -13,6 +13,7 @@ std::string PreviewSettings::validate() const {
   if (std::string e = clustering.validate(); !e.empty()) return e;
   if (!(clampFraction >= 0.0f && clampFraction < 1.0f)) return "VPL clamp fraction must be in [0, 1)";
   if (clustersPerPass < 1) return "clusters per pass must be at least 1";
+  if (!(pixelChoiceShare >= 0.0f && pixelChoiceShare <= 1.0f)) return "pixel choice share must be in [0, 1]";
   return {};
 }
 
@@ -218,8 +219,9 @@ VplField buildVplField(const RenderScene& scene, const Camera& camera, std::shar
 
 PixelShaderFactory previewShader(const RenderScene& scene, const VplField& field, const PreviewSettings& settings) {
   const int m = settings.clustersPerPass;
-  return [&scene, &field, m](uint32_t, uint64_t) -> PixelShader {
-    return [&scene, &field, m](const Ray& ray, uint64_t pixel, PixelSampler& sampler, PathStats& stats) -> glm::vec3 {
+  const float pixelShare = settings.pixelChoiceShare;
+  return [&scene, &field, m, pixelShare](uint32_t, uint64_t) -> PixelShader {
+    return [&scene, &field, m, pixelShare](const Ray& ray, uint64_t pixel, PixelSampler& sampler, PathStats& stats) -> glm::vec3 {
       const EmitterSet& emitters = scene.emitters();
       const RayHit hit = scene.accel().intersect(ray);
       ++stats.rays;
@@ -239,18 +241,16 @@ PixelShaderFactory previewShader(const RenderScene& scene, const VplField& field
       const Distribution1D& choice = field.clusterChoice[s];
       if (choice.empty()) return L;
       const auto& clusters = field.clusters.slices[s].clusters;
-      // Each cluster's probability: a fifth the slice's choice, four fifths its weight moved to this
-      // very hit (ClusterPoints). A cluster close to the hit but far from the slice's centre, or
-      // hidden from the centre, was otherwise a rare, bright draw: a sparkle. (relMSE at 2 s against
-      // the slice's choice alone: 0.16x on the interior, 0.56x on two_rooms; bench figures in
-      // docs/preview/preview.md.)
+      // Each cluster's probability: partly the slice's choice, mostly (pixelChoiceShare) its weight
+      // moved to this very hit (ClusterPoints). A cluster close to the hit but far from the slice's
+      // centre, or hidden from it, was otherwise a rare, bright draw: a sparkle.
       const ClusterPoints& points = field.clusterPoints[s];
       static thread_local std::vector<float> pmf;
       pmf.resize(points.size());
       const glm::vec3 x = surface.position, n = surface.shadingNormal;
       const float clamp2 = field.minDistance * field.minDistance;
       float total = 0.0f;
-      for (size_t c = 0; c < points.size(); ++c) {
+      for (size_t c = 0; c < points.size() && pixelShare > 0.0f; ++c) {
         const float dx = points.px[c] - x.x, dy = points.py[c] - x.y, dz = points.pz[c] - x.z;
         const float d2 = dx * dx + dy * dy + dz * dz;
         const float cosLight = std::max(0.0f, -(points.nx[c] * dx + points.ny[c] * dy + points.nz[c] * dz));
@@ -258,9 +258,8 @@ PixelShaderFactory previewShader(const RenderScene& scene, const VplField& field
         pmf[c] = points.weight[c] * cosLight * cosHere / std::max(d2 * std::max(d2, clamp2), 1e-30f);
         total += pmf[c];
       }
-      constexpr float kPixelShare = 0.8f;
-      const float own = total > 0.0f && std::isfinite(total) ? kPixelShare / total : 0.0f;
-      const float shared = own > 0.0f ? 1.0f - kPixelShare : 1.0f;
+      const float own = total > 0.0f && std::isfinite(total) ? pixelShare / total : 0.0f;
+      const float shared = own > 0.0f ? 1.0f - pixelShare : 1.0f;
       for (size_t c = 0; c < points.size(); ++c) pmf[c] = pmf[c] * own + shared * choice.pmf(c);
       // Systematic sampling: the m picks sit at (i + u) / m of the CDF, one in each m-th of it. Each
       // pick alone is distributed by the pmf (so the sum stays unbiased), and u itself is

@@ -96,6 +96,41 @@ TEST(Preview, FirstPassesConvergeToTheManyPassLimit) {
   }
 }
 
+// The pixel's own cluster choice (pixelChoiceShare) changes only how the clusters are drawn, not
+// their sum: many passes with it and without it (the slice's choice alone) give the same image. The
+// image means must agree within 1 %, and the median per-pixel squared difference of the two settings'
+// images must stay under half the sum of each setting's difference between the halves of its passes
+// (each half has half the passes, so that sum is four times the difference noise alone would give).
+TEST(Preview, PixelChoiceKeepsTheClusteredSum) {
+  for (const std::string scene : {"cornell_glossy.gltf", "two_rooms.gltf"}) {
+    const RenderScene rs(loadGltf(test::sourceDir() + "/scenes/" + scene));
+    const Camera camera(defaultCamera(rs.data()), 32, 24);
+    PreviewSettings own, slice;
+    own.vpl.count = slice.vpl.count = 4096;
+    slice.pixelChoiceShare = 0.0f;
+    const VplField field = buildVplField(rs, camera, std::make_shared<VplSet>(traceVpls(rs, own.vpl)), own);
+    struct Run {
+      Image all, halfA, halfB;
+    };
+    const auto run = [&](const PreviewSettings& settings, uint64_t firstPass) {
+      const TileRenderer renderer(camera, 5, previewShader(rs, field, settings));
+      Film all(32, 24), a(32, 24), b(32, 24);
+      for (uint64_t pass = firstPass; pass < firstPass + 1024; ++pass) renderer.renderPass(pass % 2 ? b : a, pass);
+      for (uint64_t pass = firstPass; pass < firstPass + 1024; ++pass) renderer.renderPass(all, pass);
+      return Run{all.resolve(), a.resolve(), b.resolve()};
+    };
+    const Run withPixel = run(own, 0), sliceOnly = run(slice, 4096);
+    const double bias = relativeBias(withPixel.all, sliceOnly.all);
+    const double between = medianRelativeSquaredError(withPixel.all, sliceOnly.all);
+    const double halves = medianRelativeSquaredError(withPixel.halfA, withPixel.halfB) +
+                          medianRelativeSquaredError(sliceOnly.halfA, sliceOnly.halfB);
+    std::printf("%s: pixel choice against the slice's alone: mean %+.4f, median per-pixel error %.3g (halves' sum %.3g)\n",
+                scene.c_str(), bias, between, halves);
+    EXPECT_LT(std::abs(bias), 0.01) << scene;
+    EXPECT_LT(between, 0.5 * halves) << scene;
+  }
+}
+
 // The viewer's first preview (coarsePreviewSettings: few slices, few clusters per pixel) shows the same
 // light as the full one: the two images' means agree, after one coarse pass and after many.
 TEST(Preview, CoarseFirstPreviewMatchesTheFullOne) {
