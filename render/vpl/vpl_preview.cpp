@@ -250,7 +250,11 @@ PixelShaderFactory previewShader(const RenderScene& scene, const VplField& field
       const glm::vec3 x = surface.position, n = surface.shadingNormal;
       const float clamp2 = field.minDistance * field.minDistance;
       float total = 0.0f;
-      for (size_t c = 0; c < points.size() && pixelShare > 0.0f; ++c) {
+      // Past a few hundred clusters (--clusters raised, or one slice of single VPLs) the sweep would
+      // cost more than the shadow rays it saves: the slice's choice alone.
+      constexpr size_t kMaxSwept = 1024;
+      const bool sweep = pixelShare > 0.0f && points.size() <= kMaxSwept;
+      for (size_t c = 0; sweep && c < points.size(); ++c) {
         const float dx = points.px[c] - x.x, dy = points.py[c] - x.y, dz = points.pz[c] - x.z;
         const float d2 = dx * dx + dy * dy + dz * dz;
         const float cosLight = std::max(0.0f, -(points.nx[c] * dx + points.ny[c] * dy + points.nz[c] * dz));
