@@ -254,17 +254,27 @@ PixelShaderFactory previewShader(const RenderScene& scene, const VplField& field
       // cost more than the shadow rays it saves: the slice's choice alone.
       constexpr size_t kMaxSwept = 1024;
       const bool sweep = pixelShare > 0.0f && points.size() <= kMaxSwept;
-      for (size_t c = 0; sweep && c < points.size(); ++c) {
-        const float dx = points.px[c] - x.x, dy = points.py[c] - x.y, dz = points.pz[c] - x.z;
-        const float d2 = dx * dx + dy * dy + dz * dz;
-        const float cosLight = std::max(0.0f, -(points.nx[c] * dx + points.ny[c] * dy + points.nz[c] * dz));
-        const float cosHere = std::max(0.0f, n.x * dx + n.y * dy + n.z * dz);
-        pmf[c] = points.weight[c] * cosLight * cosHere / std::max(d2 * std::max(d2, clamp2), 1e-30f);
-        total += pmf[c];
+      if (sweep) {
+        for (size_t c = 0; c < points.size(); ++c) {  // no sum in this loop, so that it vectorizes
+          const float dx = points.px[c] - x.x, dy = points.py[c] - x.y, dz = points.pz[c] - x.z;
+          const float d2 = dx * dx + dy * dy + dz * dz;
+          const float cosLight = std::max(0.0f, -(points.nx[c] * dx + points.ny[c] * dy + points.nz[c] * dz));
+          const float cosHere = std::max(0.0f, n.x * dx + n.y * dy + n.z * dz);
+          pmf[c] = points.weight[c] * cosLight * cosHere / std::max(d2 * std::max(d2, clamp2), 1e-30f);
+        }
+        float lanes[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+        size_t c = 0;
+        for (; c + 4 <= points.size(); c += 4)
+          for (int k = 0; k < 4; ++k) lanes[k] += pmf[c + size_t(k)];
+        for (; c < points.size(); ++c) lanes[0] += pmf[c];
+        total = (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]);
       }
-      const float own = total > 0.0f && std::isfinite(total) ? pixelShare / total : 0.0f;
-      const float shared = own > 0.0f ? 1.0f - pixelShare : 1.0f;
-      for (size_t c = 0; c < points.size(); ++c) pmf[c] = pmf[c] * own + shared * choice.pmf(c);
+      if (total > 0.0f && std::isfinite(total)) {
+        const float own = pixelShare / total, shared = 1.0f - pixelShare;
+        for (size_t c = 0; c < points.size(); ++c) pmf[c] = pmf[c] * own + shared * choice.pmf(c);
+      } else {
+        for (size_t c = 0; c < points.size(); ++c) pmf[c] = choice.pmf(c);
+      }
       // Systematic sampling: the m picks sit at (i + u) / m of the CDF, one in each m-th of it. Each
       // pick alone is distributed by the pmf (so the sum stays unbiased), and u itself is
       // stratified across passes. One sweep of the CDF serves the m sorted picks.
