@@ -261,9 +261,14 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
   // In a refining mode the preview only bridges the time until the path-traced film takes over: its
   // passes draw fewer clusters per pixel and stop after previewSeconds (one at least), so that
   // refinement starts soon even where a full preview pass takes seconds (a large view of a large scene).
+  // They also skip the pixel's own cluster choice: with four clusters its sweep costs about as much as
+  // their rays (the interior at 1280x720 began refining at 3.06 s with it, 2.83 s without).
   const bool refining = request.mode != SamplingMode::Preview;
   PreviewSettings previewSettings = settings_.preview;
-  if (refining) previewSettings.clustersPerPass = std::min(previewSettings.clustersPerPass, CoarsePreview{}.clustersPerPass);
+  if (refining) {
+    previewSettings.clustersPerPass = std::min(previewSettings.clustersPerPass, CoarsePreview{}.clustersPerPass);
+    previewSettings.pixelChoiceShare = 0.0f;
+  }
   const PixelShaderFactory previewShading = previewShader(scene, *state.field, previewSettings);
   const int previewTarget = refining ? settings_.previewPasses : settings_.maxSpp;
   const auto previewStart = Clock::now();
