@@ -29,29 +29,13 @@ bool vplVisible(const RenderScene& scene, const SurfaceHit& at, const Vpl& light
   return !scene.accel().occluded(spawnShadowRay(at, wi, dist));
 }
 
-// A point light's transport to x facing n without visibility or BSDFs: both cosines over the
-// clamped squared distance (the diffuse part of vplContribution, up to the albedos).
-float unoccludedTransport(const glm::vec3& light, const glm::vec3& lightNormal, const glm::vec3& x, const glm::vec3& n,
-                          float minDistance) {
-  const glm::vec3 d = light - x;
-  const float d2 = glm::dot(d, d);
-  const float cosLight = std::max(0.0f, -glm::dot(lightNormal, d)), cosHere = std::max(0.0f, glm::dot(n, d));
-  return cosLight * cosHere / std::max(d2 * std::max(d2, minDistance * minDistance), 1e-30f);
-}
-
 // The light matrix entries LightSlice samples: VPL j seen from slice i's representative.
 class SliceTransport final : public LightTransport {
  public:
   SliceTransport(const RenderScene& scene, const VplField& field) : scene_(scene), field_(field) {
     bsdfs_.reserve(field.tree.slices.size());
     for (const Slice& s : field.tree.slices) bsdfs_.push_back(scene.bsdf(field.gather.hits[s.representative]));
-    const auto& vpls = field.vpls->vpls;
-    for (auto* a : {&px_, &py_, &pz_, &nx_, &ny_, &nz_, &power_}) a->resize(vpls.size());
-    for (size_t j = 0; j < vpls.size(); ++j) {
-      px_[j] = vpls[j].position.x, py_[j] = vpls[j].position.y, pz_[j] = vpls[j].position.z;
-      nx_[j] = vpls[j].normal.x, ny_[j] = vpls[j].normal.y, nz_[j] = vpls[j].normal.z;
-      power_[j] = vpls[j].power();
-    }
+    for (const Vpl& v : field.vpls->vpls) lights_.push(v.position, v.normal, v.power());
   }
   float contribution(uint32_t slice, uint32_t vplIndex, bool visible) const override {
     const uint32_t g = field_.tree.slices[slice].representative;
@@ -69,21 +53,15 @@ class SliceTransport final : public LightTransport {
     const uint32_t g = field_.tree.slices[slice].representative;
     const glm::vec3 x = field_.gather.hits[g].position, n = field_.gather.hits[g].shadingNormal;
     const float clamp2 = field_.minDistance * field_.minDistance;
-    const size_t count = std::min(out.size(), px_.size());
-    for (size_t j = 0; j < count; ++j) {
-      const float dx = px_[j] - x.x, dy = py_[j] - x.y, dz = pz_[j] - x.z;
-      const float d2 = dx * dx + dy * dy + dz * dz;
-      const float cosLight = std::max(0.0f, -(nx_[j] * dx + ny_[j] * dy + nz_[j] * dz));  // x |d|
-      const float cosHere = std::max(0.0f, n.x * dx + n.y * dy + n.z * dz);              // x |d|
-      out[j] = power_[j] * cosLight * cosHere / std::max(d2 * std::max(d2, clamp2), 1e-30f);
-    }
+    const size_t count = std::min(out.size(), lights_.size());
+    for (size_t j = 0; j < count; ++j) out[j] = lights_.transport(j, x, n, clamp2);
   }
 
  private:
   const RenderScene& scene_;
   const VplField& field_;
   std::vector<Bsdf> bsdfs_;
-  std::vector<float> px_, py_, pz_, nx_, ny_, nz_, power_;  // the VPLs, one array per coordinate
+  PointLights lights_;  // the VPLs, weighted by power
 };
 
 // The slice whose clusters a preview pass uses at gather point g: g's, or one of its 8 nearest, drawn
@@ -191,11 +169,15 @@ VplField buildVplField(const RenderScene& scene, const Camera& camera, std::shar
     // A cluster the centre faces away from (a column's far side) takes the slice's mean ratio.
     ClusterPoints& points = field.clusterPoints[s];
     const SurfaceHit& centre = field.gather.hits[field.tree.slices[s].representative];
+    for (const VplCluster& c : clusters) {  // weight 1 until the transport at the centre is known
+      const Vpl& light = field.vpls->vpls[c.representative];
+      points.push(light.position, light.normal, 1.0f);
+    }
+    const float clamp2 = field.minDistance * field.minDistance;
     std::vector<float> transport(clusters.size());
     double estimates = 0.0, unoccluded = 0.0;
     for (size_t c = 0; c < clusters.size(); ++c) {
-      const Vpl& light = field.vpls->vpls[clusters[c].representative];
-      transport[c] = unoccludedTransport(light.position, light.normal, centre.position, centre.shadingNormal, field.minDistance);
+      transport[c] = points.transport(c, centre.position, centre.shadingNormal, clamp2);
       if (transport[c] > 0.0f) {
         estimates += clusters[c].estimate;
         unoccluded += double(clusters[c].totalPower) * transport[c];
@@ -204,14 +186,11 @@ VplField buildVplField(const RenderScene& scene, const Camera& camera, std::shar
     const float meanRatio = unoccluded > 0.0 ? float(estimates / unoccluded) : 0.0f;
     constexpr float kUnoccludedShare = 3.0f;
     for (size_t c = 0; c < clusters.size(); ++c) {
-      const Vpl& light = field.vpls->vpls[clusters[c].representative];
-      points.px.push_back(light.position.x), points.py.push_back(light.position.y), points.pz.push_back(light.position.z);
-      points.nx.push_back(light.normal.x), points.ny.push_back(light.normal.y), points.nz.push_back(light.normal.z);
       // Hidden from the centre is not hidden from every pixel (light through a slit, round a
       // column): the unoccluded weight at the mean ratio is added, three times the visible one.
       const float w = (transport[c] > 0.0f ? clusters[c].estimate / transport[c] : meanRatio * clusters[c].totalPower) +
                       kUnoccludedShare * meanRatio * clusters[c].totalPower;
-      points.weight.push_back(std::isfinite(w) ? w : 0.0f);
+      points.weight[c] = std::isfinite(w) ? w : 0.0f;
     }
   }
   return field;
@@ -255,13 +234,7 @@ PixelShaderFactory previewShader(const RenderScene& scene, const VplField& field
       constexpr size_t kMaxSwept = 1024;
       const bool sweep = pixelShare > 0.0f && points.size() <= kMaxSwept;
       if (sweep) {
-        for (size_t c = 0; c < points.size(); ++c) {  // no sum in this loop, so that it vectorizes
-          const float dx = points.px[c] - x.x, dy = points.py[c] - x.y, dz = points.pz[c] - x.z;
-          const float d2 = dx * dx + dy * dy + dz * dz;
-          const float cosLight = std::max(0.0f, -(points.nx[c] * dx + points.ny[c] * dy + points.nz[c] * dz));
-          const float cosHere = std::max(0.0f, n.x * dx + n.y * dy + n.z * dz);
-          pmf[c] = points.weight[c] * cosLight * cosHere / std::max(d2 * std::max(d2, clamp2), 1e-30f);
-        }
+        for (size_t c = 0; c < points.size(); ++c) pmf[c] = points.transport(c, x, n, clamp2);  // vectorizes: no sum here
         float lanes[4] = {0.0f, 0.0f, 0.0f, 0.0f};
         size_t c = 0;
         for (; c + 4 <= points.size(); c += 4)

@@ -16,6 +16,7 @@
 //                                       the rest by its slice's choice; 0 is the choice of the slice alone
 //                                       (relMSE at 2 s against 0: 0.16x interior, 0.56x two_rooms, 0.38x Cornell box)
 #pragma once
+#include <algorithm>
 #include <memory>
 #include <string>
 #include <vector>
@@ -37,14 +38,32 @@ struct PreviewSettings {
   std::string validate() const;
 };
 
-// A slice's clusters as point lights (their representatives' positions and normals) in arrays a
-// pixel sweeps: a pass weighs every cluster by its unoccluded transport to the pixel's own hit, so
-// that a cluster next to that hit is drawn as often as it matters there, not as at the slice's centre.
-struct ClusterPoints {
-  std::vector<float> px, py, pz, nx, ny, nz;
-  std::vector<float> weight;  // (visible estimate + unoccluded share) / unoccluded transport, at the slice representative
+// Point lights (VPLs, or clusters by their representatives) as one array per coordinate, each with
+// a weight: the loops that weigh all of them against one receiver vectorize.
+struct PointLights {
+  std::vector<float> px, py, pz, nx, ny, nz, weight;
   size_t size() const { return px.size(); }
+  void push(const glm::vec3& position, const glm::vec3& normal, float w) {
+    px.push_back(position.x), py.push_back(position.y), pz.push_back(position.z);
+    nx.push_back(normal.x), ny.push_back(normal.y), nz.push_back(normal.z);
+    weight.push_back(w);
+  }
+  // weight x the unoccluded diffuse transport from light j to x facing n: both cosines over the
+  // squared distance, clamped below at sqrt(clamp2) (vplContribution without the albedos).
+  float transport(size_t j, const glm::vec3& x, const glm::vec3& n, float clamp2) const {
+    const float dx = px[j] - x.x, dy = py[j] - x.y, dz = pz[j] - x.z;
+    const float d2 = dx * dx + dy * dy + dz * dz;
+    const float cosLight = std::max(0.0f, -(nx[j] * dx + ny[j] * dy + nz[j] * dz));  // x |d|
+    const float cosHere = std::max(0.0f, n.x * dx + n.y * dy + n.z * dz);              // x |d|
+    return weight[j] * cosLight * cosHere / std::max(d2 * std::max(d2, clamp2), 1e-30f);
+  }
 };
+
+// A slice's clusters as point lights: a pass weighs every cluster by its unoccluded transport to the
+// pixel's own hit, so that a cluster next to that hit is drawn as often as it matters there, not as
+// at the slice's centre. The weight is (visible estimate + unoccluded share) / unoccluded transport,
+// at the slice representative.
+using ClusterPoints = PointLights;
 
 // Everything the preview and the guide build for one camera (VPLs are the camera-independent part).
 struct VplField {
