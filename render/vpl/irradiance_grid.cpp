@@ -31,7 +31,16 @@ glm::uvec3 coordsOf(uint32_t key) { return {(key >> 16) & kCoordMax, (key >> 8) 
 int levelOf(uint32_t key) { return int(key >> 27) & 7; }
 uint32_t bucketOfKey(uint32_t key) { return (key >> 24) & 7u; }
 
-size_t slotHash(uint32_t key) { return size_t(mix64(key)); }
+// Linear probing in a power-of-two table whose key at slot i is keyAt(i), 0 marking an empty slot:
+// the slot that holds `key`, or the empty slot where the search for it ended. The table must have
+// an empty slot.
+template <class KeyAt>
+size_t probe(uint32_t key, size_t tableSize, KeyAt keyAt) {
+  const size_t mask = tableSize - 1;
+  size_t i = size_t(mix64(key)) & mask;
+  while (keyAt(i) != key && keyAt(i) != 0) i = (i + 1) & mask;
+  return i;
+}
 
 }  // namespace
 
@@ -43,11 +52,8 @@ uint32_t IrradianceGrid::keyOf(const glm::vec3& p, const glm::vec3& n, int level
 
 int32_t IrradianceGrid::find(uint32_t key) const {
   if (keys_.empty()) return -1;
-  const size_t mask = keys_.size() - 1;
-  for (size_t i = slotHash(key) & mask;; i = (i + 1) & mask) {
-    if (keys_[i] == key) return slots_[i];
-    if (keys_[i] == 0) return -1;
-  }
+  const size_t i = probe(key, keys_.size(), [&](size_t j) { return keys_[j]; });
+  return keys_[i] == key ? slots_[i] : -1;
 }
 
 IrradianceGrid::Cell& IrradianceGrid::insert(uint32_t key) {
@@ -56,25 +62,20 @@ IrradianceGrid::Cell& IrradianceGrid::insert(uint32_t key) {
     std::vector<int32_t> slots(keys.size(), -1);
     for (size_t j = 0; j < keys_.size(); ++j) {
       if (keys_[j] == 0) continue;
-      size_t i = slotHash(keys_[j]) & (keys.size() - 1);
-      while (keys[i] != 0) i = (i + 1) & (keys.size() - 1);
+      const size_t i = probe(keys_[j], keys.size(), [&](size_t k) { return keys[k]; });
       keys[i] = keys_[j];
       slots[i] = slots_[j];
     }
     keys_ = std::move(keys);
     slots_ = std::move(slots);
   }
-  const size_t mask = keys_.size() - 1;
-  for (size_t i = slotHash(key) & mask;; i = (i + 1) & mask) {
-    if (keys_[i] == key) return cells_[size_t(slots_[i])];
-    if (keys_[i] == 0) {
-      keys_[i] = key;
-      slots_[i] = int32_t(cells_.size());
-      Cell& c = cells_.emplace_back();
-      c.key = key;
-      return c;
-    }
-  }
+  const size_t i = probe(key, keys_.size(), [&](size_t j) { return keys_[j]; });
+  if (keys_[i] == key) return cells_[size_t(slots_[i])];
+  keys_[i] = key;
+  slots_[i] = int32_t(cells_.size());
+  Cell& c = cells_.emplace_back();
+  c.key = key;
+  return c;
 }
 
 void IrradianceGrid::splat(const std::vector<Vpl>& vpls, float weight) {
@@ -168,12 +169,8 @@ IrradianceGrid::IrradianceGrid(const RenderScene& scene, int photons, uint64_t s
   }
   // Filled to at most 2/3 (a hit rarely probes past its cache line).
   resolved_.assign(std::bit_ceil(std::max<size_t>(64, 3 * cells_.size() / 2)), Resolved{});
-  for (size_t c = 0; c < cells_.size(); ++c) {
-    const size_t mask = resolved_.size() - 1;
-    size_t i = slotHash(cells_[c].key) & mask;
-    while (resolved_[i].key != 0) i = (i + 1) & mask;
-    resolved_[i] = {cells_[c].key, resolved[c]};
-  }
+  for (size_t c = 0; c < cells_.size(); ++c)
+    resolved_[probe(cells_[c].key, resolved_.size(), [&](size_t j) { return resolved_[j].key; })] = {cells_[c].key, resolved[c]};
   // The construction's tables are not needed by lookups.
   cellCount_ = cells_.size();
   keys_ = {};
@@ -183,13 +180,10 @@ IrradianceGrid::IrradianceGrid(const RenderScene& scene, int photons, uint64_t s
 
 glm::vec3 IrradianceGrid::irradiance(const glm::vec3& p, const glm::vec3& n) const {
   if (resolved_.empty()) return glm::vec3(0.0f);
-  const size_t mask = resolved_.size() - 1;
   for (int level = 0; level < kLevels; ++level) {
     const uint32_t key = keyOf(p, n, level);
-    for (size_t i = slotHash(key) & mask;; i = (i + 1) & mask) {
-      if (resolved_[i].key == key) return resolved_[i].irradiance;
-      if (resolved_[i].key == 0) break;
-    }
+    const Resolved& r = resolved_[probe(key, resolved_.size(), [&](size_t j) { return resolved_[j].key; })];
+    if (r.key == key) return r.irradiance;
   }
   return glm::vec3(0.0f);
 }

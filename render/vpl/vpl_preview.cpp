@@ -220,53 +220,59 @@ PixelShaderFactory previewShader(const RenderScene& scene, const VplField& field
       const Distribution1D& choice = field.clusterChoice[s];
       if (choice.empty()) return L;
       const auto& clusters = field.clusters.slices[s].clusters;
+      // The light of cluster c drawn with probability p by each of the m picks.
+      const auto add = [&](size_t c, float p) {
+        const VplCluster& cluster = clusters[c];
+        const Vpl& light = field.vpls->vpls[cluster.representative];
+        const float repPower = light.power();
+        if (!(repPower > 0.0f)) return;
+        const glm::vec3 contribution =
+            vplContribution(light, surface.position, bsdf, wo, field.minDistance) * (cluster.totalPower / repPower);
+        if (!isBlack(contribution) && vplVisible(scene, surface, light, &stats)) L += contribution / (float(m) * p);
+      };
+      // Systematic sampling: the m picks sit at (i + u) / m of the CDF, one in each m-th of it. Each
+      // pick alone is distributed by the pmf (so the sum stays unbiased), and u itself is
+      // stratified across passes.
+      const float u = choices.x;
+
       // Each cluster's probability: partly the slice's choice, mostly (pixelChoiceShare) its weight
       // moved to this very hit (ClusterPoints). A cluster close to the hit but far from the slice's
-      // centre, or hidden from it, was otherwise a rare, bright draw: a sparkle.
-      const ClusterPoints& points = field.clusterPoints[s];
-      static thread_local std::vector<float> pmf;
-      pmf.resize(points.size());
-      const glm::vec3 x = surface.position, n = surface.shadingNormal;
-      const float clamp2 = field.minDistance * field.minDistance;
-      float total = 0.0f;
-      // Past a few hundred clusters (--clusters raised, or one slice of single VPLs) the sweep would
-      // cost more than the shadow rays it saves: the slice's choice alone.
+      // centre, or hidden from it, was otherwise a rare, bright draw: a sparkle. Past a few hundred
+      // clusters (--clusters raised, or one slice of single VPLs) the sweep would cost more than the
+      // shadow rays it saves, and the slice's choice decides alone.
       constexpr size_t kMaxSwept = 1024;
-      const bool sweep = pixelShare > 0.0f && points.size() <= kMaxSwept;
-      if (sweep) {
-        for (size_t c = 0; c < points.size(); ++c) pmf[c] = points.transport(c, x, n, clamp2);  // vectorizes: no sum here
-        float lanes[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+      const ClusterPoints& points = field.clusterPoints[s];
+      float total = 0.0f;
+      static thread_local std::vector<float> pmf;
+      if (pixelShare > 0.0f && points.size() <= kMaxSwept) {
+        pmf.resize(points.size());
+        const float clamp2 = field.minDistance * field.minDistance;
+        for (size_t c = 0; c < points.size(); ++c) pmf[c] = points.transport(c, surface.position, surface.shadingNormal, clamp2);
+        float lanes[4] = {0.0f, 0.0f, 0.0f, 0.0f};  // the sum outside the loop above, so that it vectorizes
         size_t c = 0;
         for (; c + 4 <= points.size(); c += 4)
           for (int k = 0; k < 4; ++k) lanes[k] += pmf[c + size_t(k)];
         for (; c < points.size(); ++c) lanes[0] += pmf[c];
         total = (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]);
       }
-      if (total > 0.0f && std::isfinite(total)) {
-        const float own = pixelShare / total, shared = 1.0f - pixelShare;
-        for (size_t c = 0; c < points.size(); ++c) pmf[c] = pmf[c] * own + shared * choice.pmf(c);
-      } else {
-        for (size_t c = 0; c < points.size(); ++c) pmf[c] = choice.pmf(c);
+      if (!(total > 0.0f) || !std::isfinite(total)) {
+        for (int i = 0; i < m; ++i) {
+          float p = 0.0f;
+          const size_t c = choice.sample((float(i) + u) / float(m), &p);
+          add(c, p);
+        }
+        return L;
       }
-      // Systematic sampling: the m picks sit at (i + u) / m of the CDF, one in each m-th of it. Each
-      // pick alone is distributed by the pmf (so the sum stays unbiased), and u itself is
-      // stratified across passes. One sweep of the CDF serves the m sorted picks.
-      const float u = choices.x;
+      const float own = pixelShare / total, shared = 1.0f - pixelShare;
+      for (size_t c = 0; c < points.size(); ++c) pmf[c] = pmf[c] * own + shared * choice.pmf(c);
+      // One walk along the CDF serves the m sorted picks.
       size_t c = 0;
       float below = 0.0f;  // the CDF before cluster c
       for (int i = 0; i < m; ++i) {
         const float target = (float(i) + u) / float(m);
         while (c + 1 < points.size() && (below + pmf[c] <= target || pmf[c] <= 0.0f)) below += pmf[c++];
         while (c > 0 && !(pmf[c] > 0.0f)) below -= pmf[--c];  // rounding left the target past the last weight
-        if (!(pmf[c] > 0.0f)) continue;
-        const VplCluster& cluster = clusters[c];
-        const Vpl& light = field.vpls->vpls[cluster.representative];
-        const float repPower = light.power();
-        if (!(repPower > 0.0f)) continue;
-        const glm::vec3 contribution =
-            vplContribution(light, surface.position, bsdf, wo, field.minDistance) * (cluster.totalPower / repPower);
-        if (isBlack(contribution)) continue;
-        if (vplVisible(scene, surface, light, &stats)) L += contribution / (float(m) * pmf[c]);
+        if (pmf[c] > 0.0f) add(c, pmf[c]);
       }
       return L;
     };

@@ -1,7 +1,8 @@
 // The instant-radiosity preview (DESIGN.md §2 steps 2–5): VPLs, slices of gather points, LightSlice
 // clusters per slice, and a pixel shader that adds direct light (emitter sampling) to the indirect
 // light of the pixel's slice clusters. Each pass draws a few clusters per pixel in proportion to
-// their estimated contribution (mostly moved from the slice's centre to the pixel's own hit), so passes average to the full clustered sum: a coarse image at once, sharper with every pass.
+// their estimated contribution (mostly moved from the slice's centre to the pixel's own hit), so
+// passes average to the full clustered sum: a coarse image at once, sharper with every pass.
 //
 // Parameters (PreviewSettings):
 //   vpl.count            int    16384  VPLs (see VplSettings)
