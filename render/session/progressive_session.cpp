@@ -229,9 +229,8 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
   if (!state.field) {
     auto t = Clock::now();
     if (!vpls_) {
-      VplSettings vplSettings = settings_.preview.vpl;
-      vplSettings.seed = settings_.seed;
-      vpls_ = std::make_shared<const VplSet>(traceVpls(scene, vplSettings));
+      vpls_ = std::make_shared<const VplSet>(
+          traceVpls(scene, vplSettingsForPaths(settings_.preview.vpl, settings_.tracer.maxDepth, settings_.seed)));
     }
     const double vplSeconds = secondsSince(t);
     t = Clock::now();

@@ -85,9 +85,7 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
   std::shared_ptr<VplSet> vpls;
   if (settings.mode != SamplingMode::Brdf) {
     const auto t = Clock::now();
-    VplSettings vplSettings = settings.preview.vpl;
-    vplSettings.seed = settings.seed;
-    vpls = std::make_shared<VplSet>(traceVpls(scene, vplSettings));
+    vpls = std::make_shared<VplSet>(traceVpls(scene, vplSettingsForPaths(settings.preview.vpl, settings.tracer.maxDepth, settings.seed)));
     result.timings.vpl = secondsSince(t);
     result.rays += vpls->rays;
     result.vplCount = vpls->vpls.size();

@@ -9,7 +9,7 @@ namespace vpl {
 
 std::string VplSettings::validate() const {
   if (count < 0 || count > 50'000'000) return "VPL count must be between 0 and 50,000,000";
-  if (maxDepth < 1 || maxDepth > 256) return "VPL path depth must be between 1 and 256";
+  if (maxDepth < 0 || maxDepth > 256) return "VPL path depth must be between 0 and 256";
   return {};
 }
 
@@ -68,7 +68,7 @@ void traceLightPath(const RenderScene& scene, const VplSettings& settings, uint6
 
 VplSet traceVpls(const RenderScene& scene, const VplSettings& settings) {
   VplSet set;
-  if (settings.count == 0 || scene.emitters().empty()) return set;
+  if (settings.count == 0 || settings.maxDepth == 0 || scene.emitters().empty()) return set;
   constexpr uint64_t kBatch = 1024;
   // Batches are traced in parallel and appended in path order: the result is independent of threads.
   while (set.vpls.size() < size_t(settings.count) && set.lightPaths < 64ull * uint64_t(settings.count) + kBatch) {
@@ -83,6 +83,12 @@ VplSet traceVpls(const RenderScene& scene, const VplSettings& settings) {
   const float inv = 1.0f / float(set.lightPaths);
   for (Vpl& v : set.vpls) v.flux *= inv;
   return set;
+}
+
+VplSettings vplSettingsForPaths(VplSettings base, int pathDepth, uint64_t seed) {
+  base.maxDepth = std::clamp(pathDepth - 1, 0, 256);
+  base.seed = seed;
+  return base;
 }
 
 glm::vec3 vplContribution(const Vpl& light, const glm::vec3& x, const Bsdf& receiver, const glm::vec3& wo,

@@ -4,7 +4,10 @@
 // Parameters (VplSettings):
 //   count     int    16384  target number of VPLs; paths are traced in batches until it is reached
 //                           (measured: 16K with 200 clusters per slice beat 8K and 32K on preview relMSE)
-//   maxDepth  int    8      maximum bounces of a light path
+//   maxDepth  int    31     maximum bounces of a light path (0: no VPLs). A VPL of bounce k ends a
+//                           path of k + 1 camera-side vertices, so 31 matches the path tracer's 32
+//                           (vplSettingsForPaths sets it from the tracer's depth; 8 lost 5 % of
+//                           two_rooms' light)
 //   seed      uint64 1
 #pragma once
 #include <cstdint>
@@ -17,7 +20,7 @@ namespace vpl {
 
 struct VplSettings {
   int count = 16384;
-  int maxDepth = 8;
+  int maxDepth = 31;
   uint64_t seed = 1;
   std::string validate() const;
 };
@@ -29,6 +32,9 @@ struct VplSet {
 };
 
 VplSet traceVpls(const RenderScene& scene, const VplSettings& settings);
+
+// The VPLs that complete the paths a path tracer of `pathDepth` segments sums, traced from `seed`.
+VplSettings vplSettingsForPaths(VplSettings base, int pathDepth, uint64_t seed);
 
 // Radiance a VPL sends to receiver point x through a receiver BSDF, without visibility:
 // flux * f_vpl * f_x / max(d^2, minDistance^2) (the clamped geometry term of instant radiosity).

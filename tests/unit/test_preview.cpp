@@ -46,6 +46,35 @@ TEST(Preview, CornellMeanIsCloseToThePathTracer) {
   EXPECT_GT(preview.sliceCount, 0u);
 }
 
+// The preview sums the paths that the path tracer of the same --max-depth sums: a VPL of bounce k
+// ends a path of k + 1 camera-side vertices. two_rooms is lit mostly by long paths. Each preview is
+// the mean of eight VPL sets (one set's clustered sum moves the image mean by about 3 %), with a
+// third of the default geometry clamp. Measured: -0.9 %, -1.8 %, -4.3 % at depths 2, 4, 32; VPLs one
+// bounce short or long: -35 % or +34 % at depth 2; VPLs stopped at 8 bounces, as they once were:
+// -10.2 % at depth 32.
+TEST(Preview, SumsThePathsOfThePathTracersDepth) {
+  for (const int depth : {2, 4, PathTracerSettings{}.maxDepth}) {
+    RenderJobSettings s = settings("two_rooms.gltf", SamplingMode::Brdf, 1024);
+    s.tracer.maxDepth = depth;
+    const RenderJobResult reference = runRenderJob(s);
+    s.mode = SamplingMode::Preview;
+    s.spp = 16;
+    s.preview.clampFraction = 0.01f;
+    Image preview = reference.image;
+    std::fill(preview.pixels.begin(), preview.pixels.end(), glm::vec3(0.0f));
+    constexpr int kVplSets = 8;
+    for (int set = 1; set <= kVplSets; ++set) {
+      s.seed = uint64_t(set);
+      const RenderJobResult one = runRenderJob(s);
+      ASSERT_TRUE(allFinite(one.image));
+      for (size_t i = 0; i < preview.pixels.size(); ++i) preview.pixels[i] += one.image.pixels[i] / float(kVplSets);
+    }
+    const double bias = relativeBias(preview, reference.image);
+    std::printf("two_rooms at max depth %d: preview (8 VPL sets) against brdf, relative bias of the mean %+.4f\n", depth, bias);
+    EXPECT_LT(std::abs(bias), 0.07) << "max depth " << depth;
+  }
+}
+
 // The median over pixel-channels of (x - r)^2 / (r^2 + 0.01): the typical pixel's error, which one
 // firefly does not move.
 double medianRelativeSquaredError(const Image& image, const Image& reference) {
@@ -98,9 +127,11 @@ TEST(Preview, FirstPassesConvergeToTheManyPassLimit) {
 
 // The pixel's own cluster choice (pixelChoiceShare) changes only how the clusters are drawn, not
 // their sum: many passes with it and without it (the slice's choice alone) give the same image. The
-// image means must agree within 1 %, and the median per-pixel squared difference of the two settings'
+// image means must agree within 3 %, and the median per-pixel squared difference of the two settings'
 // images must stay under half the sum of each setting's difference between the halves of its passes
 // (each half has half the passes, so that sum is four times the difference noise alone would give).
+// The means' own noise: +1.3 % (cornell_glossy) and -1.0 % (two_rooms) at these 1024 passes, +0.34 %
+// and +0.05 % at 16384; dividing by the wrong probability gave +15 % and +44 %.
 TEST(Preview, PixelChoiceKeepsTheClusteredSum) {
   for (const std::string scene : {"cornell_glossy.gltf", "two_rooms.gltf"}) {
     const RenderScene rs(loadGltf(test::sourceDir() + "/scenes/" + scene));
@@ -125,9 +156,9 @@ TEST(Preview, PixelChoiceKeepsTheClusteredSum) {
     const double between = medianRelativeSquaredError(withPixel.all, sliceOnly.all);
     const double halves = medianRelativeSquaredError(withPixel.halfA, withPixel.halfB) +
                           medianRelativeSquaredError(sliceOnly.halfA, sliceOnly.halfB);
-    std::printf("%s: pixel choice against the slice's alone: mean %+.4f, median per-pixel error %.3g (halves' sum %.3g)\n",
-                scene.c_str(), bias, between, halves);
-    EXPECT_LT(std::abs(bias), 0.01) << scene;
+    std::printf("%s: pixel choice against the slice's alone: mean %+.4f, median per-pixel error %.3g (halves' sum %.3g); means of the halves differ by %+.4f and %+.4f\n",
+                scene.c_str(), bias, between, halves, relativeBias(withPixel.halfA, withPixel.halfB), relativeBias(sliceOnly.halfA, sliceOnly.halfB));
+    EXPECT_LT(std::abs(bias), 0.03) << scene;
     EXPECT_LT(between, 0.5 * halves) << scene;
   }
 }
