@@ -313,7 +313,7 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
   auto refineTracer = [&]() -> const PathTracer& {
     if (rule != RouletteRule::Vpl && !(rule == RouletteRule::Auto && mine.window.on())) return tracer_;
     if (!windowTracer_) {  // once per scene, when a film first asks for it
-      irradiance_ = std::make_unique<IrradianceGrid>(scene, IrradianceGrid::kPhotons, settings_.seed);
+      irradiance_ = std::make_unique<IrradianceGrid>(scene, IrradianceGrid::kPhotons, settings_.seed, settings_.tracer.maxDepth);
       PathTracerSettings windowed = settings_.tracer;
       windowed.roulette = RouletteRule::Vpl;
       windowTracer_ = std::make_unique<PathTracer>(scene, windowed, irradiance_.get());

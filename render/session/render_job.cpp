@@ -95,7 +95,7 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
   IrradianceGrid irradiance;
   const auto windowTracer = [&] {
     const auto t = Clock::now();
-    irradiance = IrradianceGrid(scene, IrradianceGrid::kPhotons, settings.seed);
+    irradiance = IrradianceGrid(scene, IrradianceGrid::kPhotons, settings.seed, settings.tracer.maxDepth);
     result.timings.irradiance = secondsSince(t);
     return std::make_unique<PathTracer>(scene, settings.tracer, &irradiance);
   };

@@ -90,7 +90,7 @@ void IrradianceGrid::splat(const std::vector<Vpl>& vpls, float weight) {
   }
 }
 
-IrradianceGrid::IrradianceGrid(const RenderScene& scene, int photons, uint64_t seed) {
+IrradianceGrid::IrradianceGrid(const RenderScene& scene, int photons, uint64_t seed, int pathDepth) {
   const SceneData& data = scene.data();
   origin_ = data.boundsMin - glm::vec3(1e-4f * scene.radius());
   finestSize_ = std::max(2.0f * scene.radius() / float(kFinestCells), 1e-20f);
@@ -130,9 +130,8 @@ IrradianceGrid::IrradianceGrid(const RenderScene& scene, int photons, uint64_t s
   constexpr int kBatch = 1 << 16;
   const int batches = std::max(1, (photons + kBatch - 1) / kBatch);
   for (int b = 0; b < batches; ++b) {
-    VplSettings batch;
+    VplSettings batch = vplSettingsForPaths({}, pathDepth, mix64(seed ^ (0x6972726164ull + uint64_t(b))));
     batch.count = std::min(kBatch, std::max(1, photons));
-    batch.seed = mix64(seed ^ (0x6972726164ull + uint64_t(b)));
     splat(traceVpls(scene, batch).vpls, 1.0f / float(batches));
   }
 

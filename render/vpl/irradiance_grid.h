@@ -32,8 +32,9 @@ class IrradianceGrid {
   static constexpr int kPhotons = 1 << 18;
 
   // Surface area from points on every triangle (a regular subdivision), incident flux from
-  // `photons` light path vertices (every surface vertex, direct light included).
-  IrradianceGrid(const RenderScene& scene, int photons, uint64_t seed);
+  // `photons` light path vertices (every surface vertex, direct light included) of the light paths
+  // that complete a path tracer's paths of `pathDepth` segments (vplSettingsForPaths).
+  IrradianceGrid(const RenderScene& scene, int photons, uint64_t seed, int pathDepth);
 
   bool empty() const { return totalFlux_ <= 0.0f; }
   // Irradiance (W/m^2 per channel) at p on a surface facing n (unit, towards the viewer's side).

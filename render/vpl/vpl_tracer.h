@@ -5,9 +5,9 @@
 //   count     int    16384  target number of VPLs; paths are traced in batches until it is reached
 //                           (measured: 16K with 200 clusters per slice beat 8K and 32K on preview relMSE)
 //   maxDepth  int    31     maximum bounces of a light path (0: no VPLs). A VPL of bounce k ends a
-//                           path of k + 1 camera-side vertices, so 31 matches the path tracer's 32
-//                           (vplSettingsForPaths sets it from the tracer's depth; 8 lost 5 % of
-//                           two_rooms' light)
+//                           path of k + 1 camera-side vertices: every caller sets it from the path
+//                           tracer's depth by vplSettingsForPaths (8, fixed, lost 5 % of two_rooms'
+//                           light)
 //   seed      uint64 1
 #pragma once
 #include <cstdint>

@@ -29,7 +29,7 @@ Rendered renderScene(const RenderScene& scene, int width, int height, int spp, u
   settings.roulette = roulette;
   settings.rrStartDepth = rrStart;
   IrradianceGrid irradiance;
-  if (roulette == RouletteRule::Vpl) irradiance = IrradianceGrid(scene, 1 << 16, seed);
+  if (roulette == RouletteRule::Vpl) irradiance = IrradianceGrid(scene, 1 << 16, seed, maxDepth);
   const PathTracer tracer(scene, settings, &irradiance);
   const TileRenderer renderer(camera, seed, pathTracerShader(tracer));
   Film film(width, height);

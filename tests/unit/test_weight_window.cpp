@@ -4,6 +4,7 @@
 #include <cmath>
 #include <gtest/gtest.h>
 #include "render/film/film.h"
+#include "render/integrator/path_tracer.h"
 #include "render/integrator/weight_window.h"
 #include "render/session/window_switch.h"
 #include "render/sampling/rng.h"
@@ -40,7 +41,7 @@ TEST(IrradianceGrid, MatchesTheFurnaceIrradiance) {
   for (const float rho : {0.0f, 0.5f}) {
     const float le = 0.5f;
     const RenderScene scene(test::furnaceScene(rho, le));
-    const IrradianceGrid grid(scene, 1 << 18, 7);
+    const IrradianceGrid grid(scene, 1 << 18, 7, PathTracerSettings{}.maxDepth);
     const double expected = 3.14159265 * le * (1.0 - std::pow(rho, 8.0f)) / (1.0 - rho);
     Rng rng(3);
     double sum = 0.0;
@@ -65,7 +66,7 @@ TEST(IrradianceGrid, IsEmptyWithoutLight) {
   noSky.explicitSky = true;
   noSky.radiance = glm::vec3(0.0f);
   const RenderScene scene(test::furnaceScene(0.5f, 0.0f), noSky);
-  const IrradianceGrid grid(scene, 1 << 12, 1);
+  const IrradianceGrid grid(scene, 1 << 12, 1, PathTracerSettings{}.maxDepth);
   EXPECT_TRUE(grid.empty());
   EXPECT_EQ(grid.irradiance(glm::vec3(0, -1, 0), glm::vec3(0, 1, 0)), glm::vec3(0.0f));
 }
