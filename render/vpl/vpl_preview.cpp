@@ -64,15 +64,18 @@ class SliceTransport final : public LightTransport {
   PointLights lights_;  // the VPLs, weighted by power
 };
 
-// The slice whose clusters a preview pass uses at gather point g: g's, or one of its 8 nearest, drawn
-// with weight (1 - d^2 / (4 r^2))^2 of the 6D distance d from g to each slice's representative (r^2:
-// that slice's mean squared radius). Each slice's clusters approximate the VPL sum with their own
-// bias; used only inside their slice, those biases showed as a mosaic of blocks that no number of
-// passes removed. Weights that depend on g alone blend them smoothly. (Weighting from each pass's own
-// hit instead, with the kd-tree's descent for its slice, put hits far from every gather point of
-// their slice into it: fireflies, 1.3-2.5x the relMSE at 2 s on the Cornell boxes.)
+// The slice whose clusters a preview pass uses at gather point g: g's, or one of its 31 nearest,
+// drawn with weight (1 - d^2 / (36 r^2))^2 of the 6D distance d from g to each slice's representative
+// (r^2: that slice's mean squared radius, so the weight ends 3 rms radii out, about 2.4 slice widths).
+// Each slice's clusters approximate the VPL sum with their own bias; used only inside their slice,
+// those biases showed as a mosaic of blocks that no number of passes removed. Weights that depend on g
+// alone blend them smoothly, and a wide blend averages many slices' biases: with a blend of 2 rms radii
+// over 8 slices, the blocks still showed on two_rooms' walls at 640x360 after 34 passes, and the
+// relMSE at 2 s was 1.16-1.27x today's (docs/preview/preview.md). (Weighting from each pass's own hit
+// instead, with the kd-tree's descent for its slice, put hits far from every gather point of their
+// slice into it: fireflies, 1.3-2.5x the relMSE at 2 s on the Cornell boxes.)
 uint32_t blendedSlice(const VplField& field, uint32_t g, float u) {
-  constexpr int kCandidates = 8;
+  constexpr int kCandidates = 32;  // SliceSettings::neighbours' default: no more are kept
   const SliceTree& tree = field.tree;
   const uint32_t own = tree.sliceOf[g];
   const std::span<const uint32_t> near = tree.neighboursOf(own);
@@ -82,7 +85,7 @@ uint32_t blendedSlice(const VplField& field, uint32_t g, float u) {
   for (int k = 0; k < count; ++k) {
     const Slice& t = tree.slices[near[size_t(k)]];
     const float d2 = embeddedDistance2(field.gather.points[g], field.gather.points[t.representative], tree.normalScale);
-    const float f = std::max(0.0f, 1.0f - d2 / std::max(4.0f * t.radius2, 1e-30f));
+    const float f = std::max(0.0f, 1.0f - d2 / std::max(36.0f * t.radius2, 1e-30f));
     weight[k] = f * f;
     total += weight[k];
   }

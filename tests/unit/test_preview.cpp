@@ -218,6 +218,21 @@ bool samePlane(const RenderScene& rs, const CameraGather& gather, size_t p, size
          std::abs(glm::dot(hp.position - hq.position, hp.geometricNormal)) <= 1e-4f * rs.radius();
 }
 
+// Pixels whose 3x3 neighbourhood lies on one wall: a pixel at an edge mixes two walls through its
+// jittered rays, a real step that is not the preview's fault.
+std::vector<uint8_t> flatPixels(const RenderScene& rs, const CameraGather& gather) {
+  const int w = kStructureWidth, h = kStructureHeight;
+  std::vector<uint8_t> flat(size_t(w) * size_t(h), 0);
+  for (int y = 1; y + 1 < h; ++y)
+    for (int x = 1; x + 1 < w; ++x) {
+      bool all = true;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) all = all && samePlane(rs, gather, size_t(y * w + x), size_t((y + dy) * w + x + dx));
+      flat[size_t(y * w + x)] = all;
+    }
+  return flat;
+}
+
 // Structure that passes cannot remove: on flat walls, the step between neighbouring pixels on either
 // side of a slice border (of `sliced`), beyond what the noise explains, must be no larger than in an
 // image without slices (one slice, one VPL per cluster: the plain VPL sum). A pair's excess is its
@@ -228,16 +243,7 @@ bool samePlane(const RenderScene& rs, const CameraGather& gather, size_t p, size
 // bias, not noise); drawing members afresh, 1.5x and 0.8x.
 double sliceBorderExcess(const RenderScene& rs, const VplField& sliced, const TwoImages& images) {
   const int w = kStructureWidth, h = kStructureHeight;
-  // Pixels whose 3x3 neighbourhood lies on one wall: a pixel at an edge mixes two walls through its
-  // jittered rays, a real step that is not the preview's fault.
-  std::vector<uint8_t> flat(size_t(w) * size_t(h), 0);
-  for (int y = 1; y + 1 < h; ++y)
-    for (int x = 1; x + 1 < w; ++x) {
-      bool all = true;
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) all = all && samePlane(rs, sliced.gather, size_t(y * w + x), size_t((y + dy) * w + x + dx));
-      flat[size_t(y * w + x)] = all;
-    }
+  const std::vector<uint8_t> flat = flatPixels(rs, sliced.gather);
   double excess = 0.0;
   size_t pairs = 0;
   auto visit = [&](int p, int q) {
@@ -262,7 +268,70 @@ double sliceBorderExcess(const RenderScene& rs, const VplField& sliced, const Tw
   return excess / double(std::max<size_t>(1, pairs));
 }
 
-TEST(Preview, PassesLeaveNoStepsAtSliceBorders) {
+// Lines: a row (or column) of a wall brighter or darker than the rows beside it. Per pixel, the
+// noise of 48 passes hides a line of a few percent; along the line it adds up. The VPL sum has texture
+// of its own (each VPL near a wall is a soft spot), so the measure is taken on the sliced image minus
+// the slice-free one, of the same VPLs. Each run of a wall's pixels along a row sums its pixels'
+// second differences across the row (a line has one sign along its whole length, noise has not),
+// divided by that sum's noise (from the two images of each): t. Under noise alone t^2 averages 1, so
+// z = sum(t^2 - 1) / sqrt(2 runs) is about standard normal; lines (or steps along rows) raise it.
+// Each run is scaled by its own noise, so a run with a firefly counts no more than a clean one (with
+// a mean of relative excesses instead, one such run outweighed lines painted into every ninth row).
+double lineScore(const RenderScene& rs, const CameraGather& gather, const TwoImages& sliced, const TwoImages& whole) {
+  const int w = kStructureWidth, h = kStructureHeight;
+  const std::vector<uint8_t> flat = flatPixels(rs, gather);
+  const auto lum = [](const Image& image, int p) { return double(luminance(image.pixels[size_t(p)])); };
+  const auto difference = [&](int p) { return 0.5 * (lum(sliced.a, p) + lum(sliced.b, p) - lum(whole.a, p) - lum(whole.b, p)); };
+  const auto variance = [&](int p) {  // of difference(p), estimated
+    const double ds = lum(sliced.a, p) - lum(sliced.b, p), dw = lum(whole.a, p) - lum(whole.b, p);
+    return 0.25 * (ds * ds + dw * dw);
+  };
+  double excess = 0.0;
+  size_t runs = 0;
+  // Runs along rows (or columns), second differences across them: to the pixels `across` away.
+  const auto scan = [&](int lines, int length, int across, auto pixelAt) {
+    for (int line = 0; line < lines; ++line) {
+      double d2 = 0.0, var = 0.0;
+      int n = 0, first = -1;
+      const auto close = [&] {
+        if (n >= 8 && var > 0.0) {
+          excess += d2 * d2 / var - 1.0;
+          ++runs;
+        }
+        d2 = var = 0.0;
+        n = 0;
+        first = -1;
+      };
+      for (int i = 0; i < length; ++i) {
+        const int p = pixelAt(line, i);
+        if (!flat[size_t(p)] || (first >= 0 && !samePlane(rs, gather, size_t(first), size_t(p)))) {
+          close();
+          if (!flat[size_t(p)]) continue;
+        }
+        if (first < 0) first = p;
+        d2 += difference(p - across) - 2.0 * difference(p) + difference(p + across);
+        var += variance(p - across) + 4.0 * variance(p) + variance(p + across);
+        ++n;
+      }
+      close();
+    }
+  };
+  scan(h, w, w, [&](int y, int x) { return y * w + x; });
+  scan(w, h, 1, [&](int x, int y) { return y * w + x; });
+  EXPECT_GT(runs, 500u);
+  return excess / std::sqrt(2.0 * double(std::max<size_t>(1, runs)));
+}
+
+// The images with lines 3 % darker painted into every ninth row and column: what the line score must see.
+TwoImages withPaintedLines(TwoImages images) {
+  for (Image* image : {&images.a, &images.b})
+    for (int y = 0; y < kStructureHeight; ++y)
+      for (int x = 0; x < kStructureWidth; ++x)
+        if (y % 9 == 4 || x % 9 == 4) image->at(x, y) *= 0.97f;
+  return images;
+}
+
+TEST(Preview, PassesLeaveNoStepsOrLinesFromSlices) {
   for (const std::string scene : {"cornell_box.gltf", "two_rooms.gltf"}) {
     const RenderScene rs(loadGltf(test::sourceDir() + "/scenes/" + scene));
     const Camera camera(defaultCamera(rs.data()), kStructureWidth, kStructureHeight);
@@ -281,6 +350,15 @@ TEST(Preview, PassesLeaveNoStepsAtSliceBorders) {
     std::printf("%s: relative excess step across the borders of %zu slices %.4g, in the slice-free VPL sum %.4g (ratio %.2f)\n",
                 scene.c_str(), sliced.tree.slices.size(), withSlices, without, withSlices / without);
     EXPECT_LT(withSlices, 2.0 * without) << scene;
+
+    // Lines within the noise, and the score's own power: 3 % lines would fail it.
+    constexpr double kMaxLineScore = 5.0;
+    const double lines = lineScore(rs, sliced.gather, slicedImages, wholeImages);
+    const double painted = lineScore(rs, sliced.gather, withPaintedLines(slicedImages), wholeImages);
+    std::printf("%s: line score (about standard normal without lines) %.2f; with 3 %% lines painted in %.2f\n",
+                scene.c_str(), lines, painted);
+    EXPECT_LT(lines, kMaxLineScore) << scene;
+    EXPECT_GT(painted, kMaxLineScore) << scene << ": the line score misses painted lines";
   }
 }
 
