@@ -223,6 +223,20 @@ PixelShaderFactory previewShader(const RenderScene& scene, const VplField& field
       const Distribution1D& choice = field.clusterChoice[s];
       if (choice.empty()) return L;
       const auto& clusters = field.clusters.slices[s].clusters;
+      // The picks are gathered first and their VPLs prefetched: with the slices blended, neighbouring
+      // pixels draw from different slices' representatives, and each first touch of a VPL was a cache
+      // miss that stalled the pass (a third of the shader's time on the interior at 1280x720).
+      struct Pick {
+        uint32_t cluster;
+        float p;
+      };
+      static thread_local std::vector<Pick> picks;
+      picks.clear();
+      const auto pick = [&](size_t c, float p) {
+        picks.push_back({uint32_t(c), p});
+        const char* vpl = reinterpret_cast<const char*>(&field.vpls->vpls[clusters[c].representative]);
+        for (size_t line = 0; line < sizeof(Vpl); line += 64) __builtin_prefetch(vpl + line);
+      };
       // The light of cluster c drawn with probability p by each of the m picks.
       const auto add = [&](size_t c, float p) {
         const VplCluster& cluster = clusters[c];
@@ -262,8 +276,9 @@ PixelShaderFactory previewShader(const RenderScene& scene, const VplField& field
         for (int i = 0; i < m; ++i) {
           float p = 0.0f;
           const size_t c = choice.sample((float(i) + u) / float(m), &p);
-          add(c, p);
+          pick(c, p);
         }
+        for (const Pick& k : picks) add(k.cluster, k.p);
         return L;
       }
       const float own = pixelShare / total, shared = 1.0f - pixelShare;
@@ -275,8 +290,9 @@ PixelShaderFactory previewShader(const RenderScene& scene, const VplField& field
         const float target = (float(i) + u) / float(m);
         while (c + 1 < points.size() && (below + pmf[c] <= target || pmf[c] <= 0.0f)) below += pmf[c++];
         while (c > 0 && !(pmf[c] > 0.0f)) below -= pmf[--c];  // rounding left the target past the last weight
-        if (pmf[c] > 0.0f) add(c, pmf[c]);
+        if (pmf[c] > 0.0f) pick(c, pmf[c]);
       }
+      for (const Pick& k : picks) add(k.cluster, k.p);
       return L;
     };
   };
