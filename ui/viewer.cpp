@@ -289,9 +289,12 @@ int runViewer(const ViewerOptions& options) {
       ++framesSinceLog;
       // The screenshot's frame is always logged: a script can tell which stage it shows.
       if (log && (secondsSince(lastLog) >= 1.0 || shoot)) {
-        std::fprintf(log, "t %.2f fps %.1f stage %s spp %d first_frame_ms %.1f first_preview_ms %.1f samples_per_s %.4g\n",
+        std::fprintf(log,
+                     "t %.2f fps %.1f stage %s spp %d first_frame_ms %.1f first_preview_ms %.1f refine_start_ms %.1f "
+                     "samples_per_s %.4g\n",
                      secondsSince(opened), framesSinceLog / secondsSince(lastLog), stageName(stats.stage), stats.spp,
-                     1e3 * stats.firstFrameSeconds, 1e3 * stats.firstPreviewSeconds, stats.samplesPerSecond);
+                     1e3 * stats.firstFrameSeconds, 1e3 * stats.firstPreviewSeconds, 1e3 * stats.refineStartSeconds,
+                     stats.samplesPerSecond);
         std::fflush(log);
         framesSinceLog = 0;
         lastLog = Clock::now();
