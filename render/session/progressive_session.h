@@ -37,7 +37,7 @@ struct SessionSettings {
   uint64_t seed = 1;
   int threads = 0;           // render workers; 0: every core
   int previewPasses = 4;      // refining modes: preview passes at most (fewer clusters per pixel than `preview` mode)
-  double previewSeconds = 1.0;  // refining modes: ... and for this long at most, one pass at least
+  double previewSeconds = 1.0;  // refining modes: ... and a pass begun only if it should end by then (one at least)
   int handoverSpp = 16;      // path-traced samples before the display leaves the preview
   int maxSpp = 1 << 16;      // the controller idles after this many path-traced samples
   int maxSlices = 384;       // slices (cache points) per view at most; 0: preview.slices alone decides
