@@ -51,9 +51,13 @@ DisplayPipeline::DisplayPipeline(const GlApi& gl) : gl_(gl) {
   gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
   gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
   gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  gl.GenFramebuffers(1, &frameBuffer_);
+  gl.GenTextures(1, &frameTexture_);
 }
 
 DisplayPipeline::~DisplayPipeline() {
+  gl_.DeleteFramebuffers(1, &frameBuffer_);
+  gl_.DeleteTextures(1, &frameTexture_);
   gl_.DeleteTextures(1, &texture_);
   gl_.DeleteVertexArrays(1, &vertexArray_);
   gl_.DeleteProgram(program_);
@@ -66,13 +70,24 @@ void DisplayPipeline::upload(const Image& image) {
   gl_.TexImage2D(GL_TEXTURE_2D, 0, GL_RGB32F, image.width, image.height, 0, GL_RGB, GL_FLOAT, image.pixels.data());
   width_ = image.width;
   height_ = image.height;
+  shaded_.valid = false;
 }
 
-void DisplayPipeline::draw(int viewportWidth, int viewportHeight, float exposureStops, DisplayView view) const {
-  gl_.Viewport(0, 0, viewportWidth, viewportHeight);
-  gl_.ClearColor(0.0f, 0.0f, 0.0f, 1.0f);
-  gl_.Clear(GL_COLOR_BUFFER_BIT);
-  if (!hasImage()) return;
+void DisplayPipeline::shade(int width, int height, float exposureStops, DisplayView view) {
+  if (width != shaded_.width || height != shaded_.height) {
+    gl_.BindTexture(GL_TEXTURE_2D, frameTexture_);
+    gl_.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width, height, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
+    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    gl_.BindFramebuffer(GL_FRAMEBUFFER, frameBuffer_);
+    gl_.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, frameTexture_, 0);
+    if (gl_.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+      gl_.BindFramebuffer(GL_FRAMEBUFFER, 0);
+      throw std::runtime_error("the display's frame buffer is incomplete");
+    }
+  }
+  gl_.BindFramebuffer(GL_FRAMEBUFFER, frameBuffer_);
+  gl_.Viewport(0, 0, width, height);
   gl_.UseProgram(program_);
   gl_.ActiveTexture(GL_TEXTURE0);
   gl_.BindTexture(GL_TEXTURE_2D, texture_);
@@ -80,9 +95,27 @@ void DisplayPipeline::draw(int viewportWidth, int viewportHeight, float exposure
   gl_.Uniform1f(exposureLocation_, std::exp2(exposureStops));
   gl_.Uniform1i(viewLocation_, int(view));
   gl_.BindVertexArray(vertexArray_);
-  gl_.DrawArrays(GL_TRIANGLES, 0, 3);
+  gl_.DrawArrays(GL_TRIANGLES, 0, 3);  // covers the viewport: no clear needed
   gl_.BindVertexArray(0);
   gl_.UseProgram(0);
+  gl_.BindFramebuffer(GL_FRAMEBUFFER, 0);
+  shaded_ = {width, height, exposureStops, view, true};
+}
+
+void DisplayPipeline::draw(int viewportWidth, int viewportHeight, float exposureStops, DisplayView view) {
+  gl_.Viewport(0, 0, viewportWidth, viewportHeight);
+  if (!hasImage() || viewportWidth <= 0 || viewportHeight <= 0) {
+    gl_.ClearColor(0.0f, 0.0f, 0.0f, 1.0f);
+    gl_.Clear(GL_COLOR_BUFFER_BIT);
+    return;
+  }
+  if (!shaded_.valid || viewportWidth != shaded_.width || viewportHeight != shaded_.height ||
+      exposureStops != shaded_.exposureStops || view != shaded_.view)
+    shade(viewportWidth, viewportHeight, exposureStops, view);
+  gl_.BindFramebuffer(GL_READ_FRAMEBUFFER, frameBuffer_);
+  gl_.BindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+  gl_.BlitFramebuffer(0, 0, viewportWidth, viewportHeight, 0, 0, viewportWidth, viewportHeight, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  gl_.BindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
 std::vector<uint8_t> DisplayPipeline::readPixels(int width, int height) const {

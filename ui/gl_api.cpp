@@ -28,6 +28,12 @@ void GlApi::load(ProcLoader loader) {
   get(GenTextures, "glGenTextures");
   get(GenVertexArrays, "glGenVertexArrays");
   get(GetError, "glGetError");
+  get(BindFramebuffer, "glBindFramebuffer");
+  get(BlitFramebuffer, "glBlitFramebuffer");
+  get(CheckFramebufferStatus, "glCheckFramebufferStatus");
+  get(DeleteFramebuffers, "glDeleteFramebuffers");
+  get(FramebufferTexture2D, "glFramebufferTexture2D");
+  get(GenFramebuffers, "glGenFramebuffers");
   get(GetProgramInfoLog, "glGetProgramInfoLog");
   get(GetProgramiv, "glGetProgramiv");
   get(GetShaderInfoLog, "glGetShaderInfoLog");
