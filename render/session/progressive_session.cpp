@@ -264,9 +264,10 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
   // passes draw two clusters per pixel, and a pass is begun only if it should end within previewSeconds
   // (one at least), so that refinement starts soon even where a full preview pass takes seconds (a
   // large view of a large scene). Stopping only once previewSeconds had passed let a second 0.75 s
-  // pass start at 0.8 s on the interior at 1280x720, and refinement began at 2.77 s instead of 2.0 s. Two clusters chosen at the pixel's own hit beat four chosen by the slice: one pass on the
-  // interior at 320x240 had relMSE 0.10-0.15 against 1.4-2.3 (4 seeds), and at 1280x720 refinement
-  // started at 2.79 s against 2.84 s (bench/preview_stages, 3 runs).
+  // pass start at 0.8 s on the interior at 1280x720, and refinement began at 2.77 s instead of 2.0 s.
+  // Two clusters chosen at the pixel's own hit beat four chosen by the slice: one pass on the interior
+  // at 320x240 had relMSE 0.10-0.15 against 1.4-2.3 (4 seeds), and at 1280x720 refinement started at
+  // 2.79 s against 2.84 s (bench/preview_stages, 3 runs).
   const bool refining = request.mode != SamplingMode::Preview;
   PreviewSettings previewSettings = settings_.preview;
   if (refining) previewSettings.clustersPerPass = std::min(previewSettings.clustersPerPass, kBridgingClustersPerPass);
