@@ -278,19 +278,18 @@ PixelShaderFactory previewShader(const RenderScene& scene, const VplField& field
           const size_t c = choice.sample((float(i) + u) / float(m), &p);
           pick(c, p);
         }
-        for (const Pick& k : picks) add(k.cluster, k.p);
-        return L;
-      }
-      const float own = pixelShare / total, shared = 1.0f - pixelShare;
-      for (size_t c = 0; c < points.size(); ++c) pmf[c] = pmf[c] * own + shared * choice.pmf(c);
-      // One walk along the CDF serves the m sorted picks.
-      size_t c = 0;
-      float below = 0.0f;  // the CDF before cluster c
-      for (int i = 0; i < m; ++i) {
-        const float target = (float(i) + u) / float(m);
-        while (c + 1 < points.size() && (below + pmf[c] <= target || pmf[c] <= 0.0f)) below += pmf[c++];
-        while (c > 0 && !(pmf[c] > 0.0f)) below -= pmf[--c];  // rounding left the target past the last weight
-        if (pmf[c] > 0.0f) pick(c, pmf[c]);
+      } else {
+        const float own = pixelShare / total, shared = 1.0f - pixelShare;
+        for (size_t c = 0; c < points.size(); ++c) pmf[c] = pmf[c] * own + shared * choice.pmf(c);
+        // One walk along the CDF serves the m sorted picks.
+        size_t c = 0;
+        float below = 0.0f;  // the CDF before cluster c
+        for (int i = 0; i < m; ++i) {
+          const float target = (float(i) + u) / float(m);
+          while (c + 1 < points.size() && (below + pmf[c] <= target || pmf[c] <= 0.0f)) below += pmf[c++];
+          while (c > 0 && !(pmf[c] > 0.0f)) below -= pmf[--c];  // rounding left the target past the last weight
+          if (pmf[c] > 0.0f) pick(c, pmf[c]);
+        }
       }
       for (const Pick& k : picks) add(k.cluster, k.p);
       return L;

@@ -5,13 +5,13 @@ A mutant is (name, file, the exact text it replaces, its replacement, what it br
 import sys
 
 MUTANTS = [
-    ("no-srgb-decode", "render/scene/gltf_materials.cpp",
+    ("no-srgb-decode", "render/scene/gltf_image.cpp",
      "lut[i] = srgb ? srgbToLinear(i / 255.0f) : i / 255.0f;",
      "lut[i] = i / 255.0f;",
      "colour textures read as linear"),
     ("ggx-x0.8", "render/material/bsdf.cpp",
-     "(ggx::D(h, params_.alpha) * ggx::G2(wo, wi, params_.alpha) / (4.0f * wo.z));",
-     "(0.8f * ggx::D(h, params_.alpha) * ggx::G2(wo, wi, params_.alpha) / (4.0f * wo.z));",
+     "(ggx::D(h, params_.alpha) * g2 / (4.0f * wo.z));",
+     "(0.8f * ggx::D(h, params_.alpha) * g2 / (4.0f * wo.z));",
      "the GGX lobe 20 % too dark"),
     ("guide-pdf-x1.05", "render/guide/guide_distribution.cpp",
      "return cellDensity_ * choice_.pmf(size_t(cellOf(w))) + defensive_ * uniformSpherePdf();",
@@ -42,8 +42,8 @@ MUTANTS = [
      "L += contribution * (float(clusters.size()) / float(m));",
      "the preview weights a sampled VPL cluster as if chosen uniformly"),
     ("preview-pixel-pmf-mismatch", "render/vpl/vpl_preview.cpp",
-     "if (pmf[c] > 0.0f) add(c, pmf[c]);",
-     "if (pmf[c] > 0.0f) add(c, 0.5f * pmf[c] + 0.5f * choice.pmf(c));",
+     "if (pmf[c] > 0.0f) pick(c, pmf[c]);",
+     "if (pmf[c] > 0.0f) pick(c, 0.5f * pmf[c] + 0.5f * choice.pmf(c));",
      "the preview divides by a cluster probability other than the one it sampled by"),
     ("vpl-depth-capped-at-8", "render/vpl/vpl_tracer.cpp",
      "base.maxDepth = std::clamp(pathDepth - 1, 0, 256);",
