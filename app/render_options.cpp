@@ -74,6 +74,10 @@ void RenderOptions::addCommonTo(CLI::App& command) {
       ->check(CLI::Range(1, 64));
   command.add_option("--max-branches", tracer.window.maxBranches, "vpl roulette: most paths one camera sample grows into")
       ->check(CLI::Range(1, 1024));
+  command.add_option("--connect-paths", connections.paths,
+                     "VPL connections: light paths traced per pass, whose vertices every camera vertex joins by "
+                     "bidirectional MIS (0: none; -1: a quarter of the pixels in the guided modes, none in brdf)")
+      ->check(CLI::Range(-1, 1 << 24));
   command.add_option("--sky", sky, "uniform sky radiance R,G,B; 0 turns it off (default: on only without lights)");
   command.add_option("--exposure", exposure, "PNG exposure in stops");
   command.add_option("--vpls", preview.vpl.count, "number of VPLs")->check(CLI::Range(0, 50'000'000));
@@ -134,6 +138,7 @@ RenderJobSettings RenderOptions::toSettings() const {
                       : roulette == "vpl" ? RouletteRule::Vpl
                       : roulette == "auto" ? RouletteRule::Auto
                                            : RouletteRule::Throughput;
+  s.connections = connections;
   s.preview = preview;
   if (sliceSize > 0)
     s.preview.slices.maxSliceSize = sliceSize;

@@ -18,6 +18,7 @@ struct RenderOptions {
   std::string bsdfProb = "0.5";  // mis: a fixed probability, or "auto" (learned per cache point)
   std::string misGuide = "exact";  // mis: exact stratified guide samples, or the Metropolis chain  // mis: "auto" (learned per cache point) or a fixed probability
   PathTracerSettings tracer;  // depth, roulette start and the weight window's flags (the rule: `roulette`)
+  ConnectionSettings connections;  // --connect-paths
   std::string out, png;
   std::string sky;  // "R,G,B", "0", or empty (automatic)
   float exposure = 0.0f;

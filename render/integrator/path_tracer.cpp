@@ -4,6 +4,7 @@
 #include <cmath>
 #include <vector>
 #include "render/core/color.h"
+#include "render/integrator/light_vertex_cache.h"
 #include "render/sampling/warps.h"
 #include "render/vpl/irradiance_grid.h"
 
@@ -17,6 +18,28 @@ bool sampleContinuation(const SurfaceHit& surface, const Bsdf& bsdf, const glm::
   if (!continuation.sample(surface, bsdf, wo, u, dir, stats)) return false;
   weight = dir.weight.x >= 0.0f ? dir.weight : bsdf.eval(wo, dir.wi) / dir.pdf;
   return !isBlack(weight) && glm::dot(dir.wi, surface.geometricNormal) > 0.0f;
+}
+
+// 1 / (1 + the other strategies' weights over this one's): the bidirectional MIS weight. Overflowing
+// sums (a near-mirror's densities) make it 0, never NaN.
+float bidirectionalWeight(float others) { return std::isfinite(others) ? 1.0f / (1.0f + others) : 0.0f; }
+
+// The density a camera vertex at `depth` is taken to sample a direction with, in the MIS weights of
+// connections: the first vertex's own strategy (the guide), BSDF sampling past it, because that is
+// what the light side, which cannot know a vertex's depth, evaluates for its vertices.
+float cameraMisPdf(int depth, ContinuationSampler& continuation, const SurfaceHit& surface, const Bsdf& bsdf,
+                   const glm::vec3& wo, const glm::vec3& wi) {
+  return depth == 0 ? continuation.pdf(surface, bsdf, wo, wi) : bsdf.pdf(wo, wi);
+}
+
+// The camera side's MIS partial sums after it samples `dir` at a vertex (Georgiev 2012, eq. 34-35).
+void advanceConnectionMis(float& dVC, float& dVCM, int depth, const SurfaceHit& surface, const Bsdf& bsdf,
+                          const glm::vec3& wo, const DirectionSample& dir) {
+  // The sample's own pdf is the BSDF's wherever the strategy left its weight (an unguided vertex).
+  const float pdf = depth == 0 || dir.weight.x >= 0.0f ? dir.pdf : bsdf.pdf(wo, dir.wi);
+  const float cosOut = std::abs(glm::dot(surface.geometricNormal, dir.wi));
+  dVC = connectionMis(cosOut / pdf) * (dVC * connectionMis(bsdf.pdf(dir.wi, wo)) + dVCM);
+  dVCM = connectionMis(1.0f / pdf);
 }
 
 }  // namespace
@@ -43,8 +66,10 @@ float BsdfContinuation::pdf(const SurfaceHit&, const Bsdf& bsdf, const glm::vec3
   return bsdf.pdf(wo, wi);
 }
 
-PathTracer::PathTracer(const RenderScene& scene, const PathTracerSettings& settings, const IrradianceGrid* irradiance)
+PathTracer::PathTracer(const RenderScene& scene, const PathTracerSettings& settings, const IrradianceGrid* irradiance,
+                       const LightVertexCache* connections)
     : scene_(scene), settings_(settings) {
+  if (connections && scene.emitters().supportsConnections()) connections_ = connections;
   const bool windowRule = settings_.roulette == RouletteRule::Vpl || settings_.roulette == RouletteRule::Auto;
   if (windowRule && irradiance && !irradiance->empty()) irradiance_ = irradiance;
 }
@@ -63,7 +88,36 @@ struct PathTracer::Branch {
   float previousPdf = 0.0f;
   int depth = 0;
   PixelSampler sampler;
+  float dVC = 0.0f, dVCM = 0.0f;  // connections' MIS partial sums; 0 at the camera: no light tracing to it
 };
+
+glm::vec3 PathTracer::connect(const SurfaceHit& surface, const Bsdf& bsdf, const glm::vec3& wo, const Branch& path,
+                              ContinuationSampler& continuation, const LightVertex& y, float scale,
+                              PathStats& stats) const {
+  if (path.depth + 1 + y.length > settings_.maxDepth) return glm::vec3(0.0f);
+  const glm::vec3 d = y.position - surface.position;
+  const float dist2 = glm::dot(d, d);
+  if (!(dist2 > 0.0f)) return glm::vec3(0.0f);
+  const float dist = std::sqrt(dist2);
+  const glm::vec3 w = d / dist;
+  const float cosCamera = glm::dot(w, surface.geometricNormal), cosLight = -glm::dot(w, y.normal);
+  if (!(cosCamera > 0.0f && cosLight > 0.0f)) return glm::vec3(0.0f);
+  const glm::vec3 fCamera = bsdf.eval(wo, w);
+  if (isBlack(fCamera)) return glm::vec3(0.0f);
+  const glm::vec3 fLight = y.bsdf.eval(-w, y.wIn);
+  if (isBlack(fLight)) return glm::vec3(0.0f);
+  // Each side's density of making the other's end vertex, in area measure at that vertex, times the
+  // ways of shifting the join further along that side (the partial sums).
+  const float cameraPdf = cameraMisPdf(path.depth, continuation, surface, bsdf, wo, w);
+  const float lightPdf = y.bsdf.pdf(y.wIn, -w);
+  const float wLight = connectionMis(cameraPdf * cosLight / dist2) * (y.dVCM + y.dVC * connectionMis(y.bsdf.pdf(-w, y.wIn)));
+  const float wCamera = connectionMis(lightPdf * cosCamera / dist2) * (path.dVCM + path.dVC * connectionMis(bsdf.pdf(w, wo)));
+  const float weight = bidirectionalWeight(wLight + wCamera);
+  if (!(weight > 0.0f)) return glm::vec3(0.0f);
+  ++stats.rays;
+  if (scene_.accel().occluded(spawnShadowRay(surface, w, dist))) return glm::vec3(0.0f);
+  return fCamera * fLight * y.alpha * (cosLight / dist2 * scale * weight);
+}
 
 glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, ContinuationSampler& continuation,
                                PathStats& stats, uint64_t pixel) const {
@@ -99,17 +153,39 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
       const SurfaceHit surface = scene_.surface(ray, hit);
       const glm::vec3 wo = -ray.direction;
       continuation.beginVertex(depth);
+      const float cosHit = std::abs(glm::dot(surface.geometricNormal, wo));
+      if (connections_) {
+        if (!(cosHit > 0.0f)) break;
+        path.dVCM *= connectionMis(hit.t * hit.t) / connectionMis(cosHit);
+        path.dVC /= connectionMis(cosHit);
+      }
 
-      // Emitter hit, weighted against next-event estimation of the same triangle.
+      // Emitter hit, weighted against next-event estimation of the same triangle (and, with
+      // connections, against every join that makes the same path).
       const glm::vec3 le = emitters.emitted(surface, wo);
       if (!isBlack(le)) {
-        const float w = depth == 0 ? 1.0f : powerHeuristic(path.previousPdf, emitters.pdfTriangle(path.previous.position, surface));
+        float w = 1.0f;
+        if (depth > 0 && connections_) {
+          const glm::vec3 d = surface.position - path.previous.position;
+          const float directPdfArea = emitters.pdfTriangle(path.previous.position, surface) * cosHit / glm::dot(d, d);
+          w = bidirectionalWeight(connectionMis(directPdfArea) * path.dVCM +
+                                  connectionMis(emitters.pdfEmission(surface, wo)) * path.dVC);
+        } else if (depth > 0) {
+          w = powerHeuristic(path.previousPdf, emitters.pdfTriangle(path.previous.position, surface));
+        }
         L += beta * le * w;
       }
       if (depth + 1 > settings_.maxDepth) break;
 
       const Bsdf bsdf = scene_.bsdf(surface, wo);
       VertexSamples u(path.sampler, depth);
+      // The light vertex to join, picked now: next-event estimation's shadow ray hides its fetch.
+      const LightVertex* joinTo = nullptr;
+      float joinScale = 0.0f;
+      if (connections_ && depth + 2 <= settings_.maxDepth && !connections_->empty()) {
+        joinTo = &connections_->pick(u.connectionChoice(), joinScale);
+        for (size_t line = 0; line < sizeof(LightVertex); line += 64) __builtin_prefetch(reinterpret_cast<const char*>(joinTo) + line);
+      }
 
       // The weight window: roulette for paths worth little against the pixel, splitting for those
       // worth much. The camera ray's hit sets the pixel's estimate, its own ratio is 1 by definition.
@@ -137,24 +213,40 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
         if (!isBlack(f) && glm::dot(ls->wi, surface.geometricNormal) > 0.0f) {
           ++stats.rays;
           if (!scene_.accel().occluded(spawnShadowRay(surface, ls->wi, ls->distance))) {
-            const float w = ls->delta ? 1.0f : powerHeuristic(ls->pdf, continuation.pdf(surface, bsdf, wo, ls->wi));
+            float w = 1.0f;
+            if (connections_) {
+              // Densities of punctual lights in the solid angle of the point they sit at (Georgiev 2012).
+              const float directPdf = ls->delta && std::isfinite(ls->distance) ? ls->pdf * ls->distance * ls->distance : ls->pdf;
+              const float wLight = ls->delta ? 0.0f : connectionMis(cameraMisPdf(depth, continuation, surface, bsdf, wo, ls->wi) / directPdf);
+              const float cameraSide = path.dVCM + path.dVC * connectionMis(bsdf.pdf(ls->wi, wo));
+              const float cosCamera = std::abs(glm::dot(surface.geometricNormal, ls->wi));
+              const float wCamera =
+                  cameraSide > 0.0f ? connectionMis(ls->emissionPdf * cosCamera / (directPdf * ls->cosLight)) * cameraSide : 0.0f;
+              w = bidirectionalWeight(wLight + wCamera);
+            } else if (!ls->delta) {
+              w = powerHeuristic(ls->pdf, continuation.pdf(surface, bsdf, wo, ls->wi));
+            }
             L += beta * f * ls->radiance * (w / ls->pdf);
           }
         }
       }
+
+      // A join to one light vertex (the VPLs' share of the paths through here).
+      if (joinTo) L += beta * connect(surface, bsdf, wo, path, continuation, *joinTo, joinScale, stats);
 
       if (depth == 0) firstContinuationStart = L;
 
       // The split's other branches first (each its own numbers), then this path's own continuation.
       const glm::vec3 branchBeta = beta / float(split);
       for (int b = 1; b < split; ++b) {
-        Branch next{Ray{}, glm::vec3(0.0f), surface, 0.0f, depth + 1, path.sampler.branch(nextBranchId++)};
+        Branch next{Ray{}, glm::vec3(0.0f), surface, 0.0f, depth + 1, path.sampler.branch(nextBranchId++), path.dVC, path.dVCM};
         VertexSamples ub(next.sampler, depth);
         DirectionSample dir;
         glm::vec3 weight;
         if (!sampleContinuation(surface, bsdf, wo, ub, continuation, stats, dir, weight)) continue;
         next.beta = branchBeta * weight;
         if (!isFiniteNonNegative(next.beta)) continue;
+        if (connections_) advanceConnectionMis(next.dVC, next.dVCM, depth, surface, bsdf, wo, dir);
         next.ray = spawnRay(surface, dir.wi);
         next.previousPdf = dir.pdf;
         pending.push_back(next);
@@ -177,6 +269,7 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
         if (u.roulette() >= survive) break;
         beta /= survive;
       }
+      if (connections_) advanceConnectionMis(path.dVC, path.dVCM, depth, surface, bsdf, wo, next);
       path.previous = surface;
       path.previousPdf = next.pdf;
       ray = spawnRay(surface, next.wi);

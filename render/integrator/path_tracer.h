@@ -83,12 +83,18 @@ class BsdfContinuation final : public ContinuationSampler {
 };
 
 class IrradianceGrid;
+class LightVertexCache;
+struct LightVertex;
 
 class PathTracer {
  public:
   // `irradiance`: the VPLs' estimate that the Vpl and Auto rules need; without it (or with no light
   // in it) they are Sqrt, with it both are the window. It must outlive the tracer.
-  PathTracer(const RenderScene& scene, const PathTracerSettings& settings, const IrradianceGrid* irradiance = nullptr);
+  // `connections`: light vertices to join every camera vertex to, weighted by bidirectional MIS
+  // (light_vertex_cache.h); its owner rebuilds it between passes. Null, or a scene whose lights
+  // connections do not support (EmitterSet::supportsConnections): none.
+  PathTracer(const RenderScene& scene, const PathTracerSettings& settings, const IrradianceGrid* irradiance = nullptr,
+             const LightVertexCache* connections = nullptr);
 
   // Radiance arriving along the camera ray, every decision drawn from its dimension of `sampler`.
   // May be non-finite only through a bug; callers check.
@@ -107,10 +113,15 @@ class PathTracer {
   struct Branch;
   // Radiance reflected at a vertex towards the path, as the VPLs predict it (luminance).
   float predictedRadiance(const SurfaceHit& surface, const Bsdf& bsdf) const;
+  // The MIS-weighted contribution of joining camera vertex `surface` to light vertex y, picked with
+  // weight `scale` (without the path's throughput); 0 when y is too long, faces away or is occluded.
+  glm::vec3 connect(const SurfaceHit& surface, const Bsdf& bsdf, const glm::vec3& wo, const Branch& path,
+                    ContinuationSampler& continuation, const LightVertex& y, float scale, PathStats& stats) const;
 
   const RenderScene& scene_;
   PathTracerSettings settings_;
   const IrradianceGrid* irradiance_ = nullptr;  // set only when the window is in use
+  const LightVertexCache* connections_ = nullptr;  // set only when the scene's lights support them
 };
 
 // Power heuristic with exponent 2 (Veach 1997, §9.2.4).

@@ -66,6 +66,12 @@ class PixelSampler {
     b.sampleKey_ = mix64(sampleKey_ ^ (0x6272616e63680000ull + id));
     return b;
   }
+  // The light vertex a path vertex connects to (render/integrator/light_vertex_cache.h): a hashed
+  // number, since a choice among a pass's many light vertices gains nothing from stratification.
+  float connectionChoice(int vertex) {
+    if (independent_) return independent_->uniform();
+    return hashedUniform(kConnectionSlot + uint32_t(vertex), 0);
+  }
   // A stream of its own for a vertex's consumer of an unbounded count of numbers.
   Rng random(int vertex) {
     if (independent_) return Rng::hashed(independent_->next() | uint64_t(independent_->next()) << 32);
@@ -74,6 +80,7 @@ class PixelSampler {
 
  private:
   static constexpr uint32_t kCameraSlot = 0, kPreviewClusterSlot = 1, kFirstVertexSlot = 2;
+  static constexpr uint32_t kConnectionSlot = 0x40000000u;  // past every vertex block
   static uint32_t slotOf(int vertex, VertexDimension d) {
     return kFirstVertexSlot + uint32_t(vertex) * uint32_t(VertexDimension::Count) + uint32_t(d);
   }
@@ -119,6 +126,7 @@ class VertexSamples {
   float strategy() { return pair(strategyGuideCell_, VertexDimension::StrategyGuideCell).x; }
   float guideCell() { return pair(strategyGuideCell_, VertexDimension::StrategyGuideCell).y; }
   glm::vec2 guidePoint() { return sampler_.get2D(vertex_, VertexDimension::GuidePoint); }
+  float connectionChoice() { return sampler_.connectionChoice(vertex_); }
   // The vertex's own random stream (Metropolis chains), made on first use.
   Rng& random() {
     if (!random_) random_ = sampler_.random(vertex_);

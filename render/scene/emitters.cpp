@@ -198,6 +198,8 @@ std::optional<LightSample> EmitterSet::sample(const glm::vec3& p, float uLight, 
       s.radiance = triangleRadiance(light, b, front);
       if (isBlack(s.radiance)) return std::nullopt;
       s.pdf = float(double(pmf) / st->solidAngle());
+      s.cosLight = std::abs(glm::dot(light.normal, s.wi));
+      s.emissionPdf = pmf * s.cosLight / (kPi * light.area * (light.twoSided ? 2.0f : 1.0f));
       return s;
     }
     // Sample an emissive triangle by area, convert the density to solid angle at p.
@@ -214,6 +216,8 @@ std::optional<LightSample> EmitterSet::sample(const glm::vec3& p, float uLight, 
     s.radiance = triangleRadiance(light, b, cosLight > 0.0f);
     if (isBlack(s.radiance)) return std::nullopt;
     s.pdf = pmf * dist2 / (std::abs(cosLight) * light.area);
+    s.cosLight = std::abs(cosLight);
+    s.emissionPdf = pmf * s.cosLight / (kPi * light.area * (light.twoSided ? 2.0f : 1.0f));
     return s;
   }
   if (int(index) == skyIndex_) {
@@ -228,6 +232,7 @@ std::optional<LightSample> EmitterSet::sample(const glm::vec3& p, float uLight, 
   if (light.type == LightType::Directional) {
     s.wi = -glm::normalize(light.direction);
     s.radiance = light.intensity;
+    s.emissionPdf = pmf / (kPi * radius_ * radius_);
     return s;
   }
   const glm::vec3 d = light.position - p;
@@ -237,6 +242,7 @@ std::optional<LightSample> EmitterSet::sample(const glm::vec3& p, float uLight, 
   s.wi = d / s.distance;
   s.radiance = light.intensity * (spotAttenuation(light, -s.wi) * rangeWindow(light, s.distance) / dist2);
   if (isBlack(s.radiance)) return std::nullopt;
+  s.emissionPdf = pmf * (light.type == LightType::Spot ? uniformConePdf(Cone::fromCos(light.cosOuter)) : uniformSpherePdf());
   return s;
 }
 
@@ -244,15 +250,53 @@ float EmitterSet::pdfTriangle(const glm::vec3& p, const SurfaceHit& hit) const {
   if (hit.mesh >= triangleIndex_.size() || triangleIndex_[hit.mesh].empty()) return 0.0f;
   const int32_t index = triangleIndex_[hit.mesh][hit.triangle];
   if (index < 0) return 0.0f;
+  return pdfTrianglePoint(p, size_t(index), hit.position, hit.geometricNormal, hit.frontFace);
+}
+
+float EmitterSet::pdfTrianglePoint(const glm::vec3& p, size_t index, const glm::vec3& x, const glm::vec3& normal,
+                                   bool front) const {
+  const TriangleLight& light = triangles_[index];
+  if (!front && !light.twoSided) return 0.0f;
+  if (std::isnan(planeDistance(p, light))) return 0.0f;  // sample() sends nothing from there
+  if (const auto st = solidAngleStrategy(p, light)) return float(double(distribution_.pmf(index)) / st->solidAngle());
+  const glm::vec3 d = x - p;
+  const float dist2 = glm::dot(d, d);
+  const float cosLight = std::abs(glm::dot(normal, d)) / std::sqrt(dist2);
+  if (!(cosLight > 1e-7f)) return 0.0f;
+  return distribution_.pmf(index) * dist2 / (cosLight * light.area);
+}
+
+float EmitterSet::pdfEmission(const SurfaceHit& hit, const glm::vec3& direction) const {
+  if (hit.mesh >= triangleIndex_.size() || triangleIndex_[hit.mesh].empty()) return 0.0f;
+  const int32_t index = triangleIndex_[hit.mesh][hit.triangle];
+  if (index < 0) return 0.0f;
   const TriangleLight& light = triangles_[size_t(index)];
   if (!hit.frontFace && !light.twoSided) return 0.0f;
-  if (std::isnan(planeDistance(p, light))) return 0.0f;  // sample() sends nothing from there
-  if (const auto st = solidAngleStrategy(p, light)) return float(double(distribution_.pmf(size_t(index))) / st->solidAngle());
-  const glm::vec3 d = hit.position - p;
-  const float dist2 = glm::dot(d, d);
-  const float cosLight = std::abs(glm::dot(hit.geometricNormal, d)) / std::sqrt(dist2);
-  if (!(cosLight > 1e-7f)) return 0.0f;
-  return distribution_.pmf(size_t(index)) * dist2 / (cosLight * light.area);
+  const float cosLight = std::abs(glm::dot(hit.geometricNormal, direction));
+  return distribution_.pmf(size_t(index)) * cosLight / (kPi * light.area * (light.twoSided ? 2.0f : 1.0f));
+}
+
+float EmitterSet::nextEventPdfTimesCos(const glm::vec3& p, const EmissionSample& e) const {
+  const float pmf = distribution_.pmf(e.emitter);
+  if (e.emitter < triangles_.size()) {
+    const TriangleLight& light = triangles_[e.emitter];
+    const glm::vec3 d = p - e.position;
+    const float dist = glm::length(d);
+    if (!(dist > 0.0f)) return 0.0f;
+    const bool front = glm::dot(e.normal, light.normal) > 0.0f;
+    return pdfTrianglePoint(p, e.emitter, e.position, light.normal, front) * std::abs(glm::dot(e.normal, d)) / dist;
+  }
+  if (int(e.emitter) == skyIndex_) return pmf * uniformSpherePdf();
+  if (punctual_[e.emitter - triangles_.size()].type == LightType::Directional) return pmf;
+  const glm::vec3 d = p - e.position;
+  return pmf * glm::dot(d, d);
+}
+
+bool EmitterSet::supportsConnections() const {
+  if (skyIndex_ >= 0) return false;
+  for (const PunctualLight& light : punctual_)
+    if (light.range > 0.0f) return false;
+  return true;
 }
 
 float EmitterSet::pdfSky(const glm::vec3&) const {
@@ -295,6 +339,8 @@ std::optional<EmissionSample> EmitterSet::sampleEmission(float uLight, glm::vec2
     e.normal = n;
     e.direction = Frame::fromNormal(n).toWorld(sampleCosineHemisphere(uDir));
     e.weight = triangleRadiance(light, b, front) * (kPi * light.area * sides / pmf);
+    e.pdf = pmf * std::max(0.0f, glm::dot(n, e.direction)) / (kPi * light.area * sides);
+    e.emitter = uint32_t(index);
     return e;
   }
   const glm::vec3 travelSky = -sampleUniformSphere(uDir);
@@ -309,6 +355,8 @@ std::optional<EmissionSample> EmitterSet::sampleEmission(float uLight, glm::vec2
     const float diskArea = kPi * radius_ * radius_;
     e.weight = isSky ? sky_ * (diskArea / (pmf * uniformSpherePdf()))
                      : punctual_[index - triangles_.size()].intensity * (diskArea / pmf);
+    e.pdf = pmf / diskArea * (isSky ? uniformSpherePdf() : 1.0f);
+    e.emitter = uint32_t(index);
     return e;
   }
   const PunctualLight& light = punctual_[index - triangles_.size()];
@@ -319,10 +367,14 @@ std::optional<EmissionSample> EmitterSet::sampleEmission(float uLight, glm::vec2
     const Cone cone = Cone::fromCos(light.cosOuter);
     e.direction = Frame::fromNormal(glm::normalize(light.direction)).toWorld(sampleUniformCone(uDir, cone));
     e.weight = light.intensity * (spotAttenuation(light, e.direction) / (uniformConePdf(cone) * pmf));
+    e.pdf = pmf * uniformConePdf(cone);
   } else {
     e.direction = sampleUniformSphere(uDir);
     e.weight = light.intensity * (1.0f / (uniformSpherePdf() * pmf));
+    e.pdf = pmf * uniformSpherePdf();
   }
+  e.emitter = uint32_t(index);
+  e.deltaPosition = true;
   return e;
 }
 

@@ -22,6 +22,11 @@ struct LightSample {
   glm::vec3 radiance{0.0f};   // Li arriving at the reference point (irradiance for delta lights)
   float pdf = 0.0f;           // solid angle density incl. the light choice; for delta lights the choice pmf
   bool delta = false;         // punctual light: no MIS with BSDF sampling
+  // What bidirectional MIS weights need (render/integrator/light_vertex_cache.h): the density with
+  // which sampleEmission() starts a light path at the sampled point towards the reference point
+  // (area x solid angle, light choice included), and the cosine at the light (1 for punctual lights).
+  float emissionPdf = 0.0f;
+  float cosLight = 1.0f;
 };
 
 // Where a light path starts (instant radiosity): a point and direction drawn from the emission.
@@ -30,6 +35,10 @@ struct EmissionSample {
   glm::vec3 normal{0.0f};     // emitter surface normal, 0 for point-like and sky
   glm::vec3 direction{0.0f};  // unit, direction of travel
   glm::vec3 weight{0.0f};     // Le cos / (pdf_pos pdf_dir): the flux the path carries, summed over N paths / N
+  float pdf = 0.0f;           // pdf_pos pdf_dir, light choice included (area x solid angle; sky and
+                              // directional: disk area x direction)
+  uint32_t emitter = 0;       // which light of the set (for nextEventPdf)
+  bool deltaPosition = false; // punctual: no ray can hit where the path starts
 };
 
 class EmitterSet {
@@ -53,6 +62,17 @@ class EmitterSet {
 
   // Starting vertex of a light path, for VPL tracing.
   std::optional<EmissionSample> sampleEmission(float uLight, glm::vec2 uPos, glm::vec2 uDir) const;
+  // Density with which sampleEmission() starts at the emitting point of a hit and leaves along
+  // `direction` (area x solid angle, light choice included): the light-tracing side of a camera
+  // path's emitter hit in bidirectional MIS.
+  float pdfEmission(const SurfaceHit& hit, const glm::vec3& direction) const;
+  // Next-event estimation's density of picking a light path's start e from p, times the cosine at
+  // the light: solid angle x cos for triangles, pmf x distance^2 for point-like lights (their
+  // delta density cancels in the ratios it serves), pmf for directional lights.
+  float nextEventPdfTimesCos(const glm::vec3& p, const EmissionSample& e) const;
+  // Whether every light here is one that bidirectional connections weight exactly: triangles and
+  // point, spot and directional lights without a range window; not the sky.
+  bool supportsConnections() const;
 
   // Emitted radiance of a surface hit towards wo (0 unless the material emits on that side).
   glm::vec3 emitted(const SurfaceHit& hit, const glm::vec3& wo) const;
@@ -94,6 +114,8 @@ class EmitterSet {
   // Signed distance from p to the triangle's plane (positive on the front side), or NaN when p lies
   // in that plane as far as the renderer can tell: no light from the triangle reaches p then.
   static float planeDistance(const glm::vec3& p, const TriangleLight& light);
+  // pdfTriangle for a point x of light `index`, facing `normal`, on side `front`.
+  float pdfTrianglePoint(const glm::vec3& p, size_t index, const glm::vec3& x, const glm::vec3& normal, bool front) const;
 };
 
 }  // namespace vpl

@@ -51,6 +51,7 @@ std::string RenderJobSettings::validate() const {
   if (timeBudget <= 0.0 && spp < 1) return "spp must be at least 1";
   if (timeBudget > 0.0 && !(timeBudget < 1e7)) return "time budget is too large";
   if (std::string e = tracer.validate(); !e.empty()) return e;
+  if (std::string e = connections.validate(); !e.empty()) return e;
   if (std::string e = preview.validate(); !e.empty()) return e;
   if (std::string e = guide.validate(); !e.empty()) return e;
   return {};
@@ -90,6 +91,14 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
     result.rays += vpls->rays;
     result.vplCount = vpls->vpls.size();
   }
+  // VPL connections: fresh light vertices every pass.
+  const int connectionPaths =
+      settings.mode == SamplingMode::Preview ? 0 : settings.connections.pathsFor(settings.width * settings.height, settings.mode);
+  const bool connecting = connectionPaths > 0 && scene.emitters().supportsConnections();
+  if (connectionPaths > 0 && !connecting && !scene.emitters().empty())
+    result.notices.push_back("VPL connections are off: they do not support the sky or lights with a range");
+  LightVertexCache connectionCache;
+  const LightVertexCache* connections = connecting ? &connectionCache : nullptr;
   // The VPL weight window's estimate and a tracer that uses it: at once for the vpl rule, when the
   // switch turns on for auto.
   IrradianceGrid irradiance;
@@ -97,9 +106,10 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
     const auto t = Clock::now();
     irradiance = IrradianceGrid(scene, IrradianceGrid::kPhotons, settings.seed, settings.tracer.maxDepth);
     result.timings.irradiance = secondsSince(t);
-    return std::make_unique<PathTracer>(scene, settings.tracer, &irradiance);
+    return std::make_unique<PathTracer>(scene, settings.tracer, &irradiance, connections);
   };
-  std::unique_ptr<PathTracer> tracer = vplRoulette ? windowTracer() : std::make_unique<PathTracer>(scene, settings.tracer);
+  std::unique_ptr<PathTracer> tracer =
+      vplRoulette ? windowTracer() : std::make_unique<PathTracer>(scene, settings.tracer, nullptr, connections);
   VplField field;
   GuideField guide;
   std::optional<SelectionLearner> learner;  // mis: each cache point's BSDF probability, from the passes so far
@@ -152,6 +162,12 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
   for (uint64_t pass = 0;; ++pass) {
     if (!timed && int(pass) >= settings.spp) break;
     if (timed && pass > 0 && stop.load()) break;
+    if (connecting) {
+      const auto t = Clock::now();
+      connectionCache.build(scene, settings.seed, pass, connectionPaths, settings.tracer.maxDepth - 1);
+      result.timings.connections += secondsSince(t);
+      result.rays += connectionCache.rays();
+    }
     // The first pass always completes: a budget never leaves an empty image.
     const PassStats stats = renderer->renderPass(film, pass, pass == 0 ? nullptr : &stop);
     result.rays += stats.rays;

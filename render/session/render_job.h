@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 #include "render/film/image.h"
+#include "render/integrator/light_vertex_cache.h"
 #include "render/integrator/path_tracer.h"
 #include "render/integrator/sampling_mode.h"
 #include "render/scene/render_scene.h"
@@ -22,6 +23,7 @@ struct RenderJobSettings {
   int spp = 16;               // used when timeBudget <= 0
   double timeBudget = 0.0;    // seconds after load (BVH, VPLs, clustering and rendering all count)
   PathTracerSettings tracer;
+  ConnectionSettings connections;  // VPL connections (path-tracing modes)
   PreviewSettings preview;  // VPLs, slices and clusters (preview and guided modes)
   GuideSettings guide;      // guided modes
   SkySettings sky;
@@ -32,6 +34,7 @@ struct RenderJobSettings {
 struct PhaseTimings {
   double load = 0, bvh = 0, vpl = 0, cluster = 0, render = 0;
   double irradiance = 0;  // the VPL roulette's irradiance grid
+  double connections = 0;  // light paths for VPL connections, all passes
   // cluster's parts: gather points, slice tree, LightSlice (reduced matrix, global clusters, per-slice
   // refinement) and, in the guided modes, the guide
   double gather = 0, slices = 0, matrix = 0, globalClusters = 0, refine = 0, guide = 0;

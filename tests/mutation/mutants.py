@@ -61,6 +61,14 @@ MUTANTS = [
      "const glm::vec3 branchBeta = beta / float(split);",
      "const glm::vec3 branchBeta = beta;",
      "a split path's branches each carry the whole weight"),
+    ("connection-weights-miss-light-side", "render/integrator/path_tracer.cpp",
+     "(y.dVCM + y.dVC * connectionMis(y.bsdf.pdf(-w, y.wIn)));",
+     "(y.dVCM);",
+     "VPL connections' MIS weights forget the strategies that join further along the light path"),
+    ("connection-one-segment-too-long", "render/integrator/path_tracer.cpp",
+     "if (path.depth + 1 + y.length > settings_.maxDepth) return glm::vec3(0.0f);",
+     "if (path.depth + 1 + y.length > settings_.maxDepth + 1) return glm::vec3(0.0f);",
+     "VPL connections make paths one segment longer than --max-depth"),
 ]
 
 

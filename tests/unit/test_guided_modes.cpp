@@ -25,7 +25,7 @@ std::string scenePath(const std::string& scene) {
 
 RenderJobSettings settings(const std::string& scene, SamplingMode mode, int spp, uint64_t seed,
                            int guidedVertices = GuideSettings{}.guidedVertices,
-                           RouletteRule roulette = RouletteRule::Sqrt) {
+                           RouletteRule roulette = RouletteRule::Sqrt, int connectPaths = -1) {
   RenderJobSettings s;
   s.scenePath = scenePath(scene);
   s.mode = mode;
@@ -37,6 +37,9 @@ RenderJobSettings settings(const std::string& scene, SamplingMode mode, int spp,
   s.preview.vpl.count = 4096;
   s.guide.guidedVertices = guidedVertices;
   s.tracer.roulette = roulette;
+  // VPL connections as the mode has them by default (on in the guided modes), with fewer light
+  // paths than the default's floor of 4096: at 16x12 pixels those would cost more than the pixels.
+  s.connections.paths = connectPaths >= 0 ? connectPaths : isGuided(mode) ? 256 : 0;
   return s;
 }
 
@@ -66,6 +69,7 @@ struct Case {
   RouletteRule roulette = RouletteRule::Sqrt;  // brdf, the reference, always uses it
   // mis as Hua & Low (the Markov chain's directions), or with each cache point's BSDF probability learned.
   enum class Mis { Default, Chain, Learned } mis = Mis::Default;
+  int connectPaths = -1;  // VPL connections' light paths per pass; -1: the mode's default (settings())
 };
 
 std::string caseName(const Case& c) {
@@ -73,7 +77,8 @@ std::string caseName(const Case& c) {
   scene = scene.substr(0, scene.find('.'));
   return scene + "_" + modeName(c.mode) + (c.guidedVertices == 0 ? "_every_vertex" : "") +
          (c.roulette == RouletteRule::Vpl ? "_vpl_roulette" : c.roulette == RouletteRule::Auto ? "_auto_roulette" : "") +
-         (c.mis == Case::Mis::Chain ? "_chain" : c.mis == Case::Mis::Learned ? "_learned" : "");
+         (c.mis == Case::Mis::Chain ? "_chain" : c.mis == Case::Mis::Learned ? "_learned" : "") +
+         (c.connectPaths == 0 ? "_no_connections" : c.connectPaths > 0 ? "_connections" : "");
 }
 
 class GuidedModes : public ::testing::TestWithParam<Case> {};
@@ -87,7 +92,7 @@ TEST_P(GuidedModes, AgreeWithBsdfSamplingPixelByPixel) {
       renderBatches(data, settings(c.scene, SamplingMode::Brdf, kSpp, 0), kBatches, 1000);
   uint64_t guideSamples = 0, discarded = 0, branches = 0;
   int windowed = 0, learned = 0;
-  RenderJobSettings s = settings(c.scene, c.mode, kSpp, 0, c.guidedVertices, c.roulette);
+  RenderJobSettings s = settings(c.scene, c.mode, kSpp, 0, c.guidedVertices, c.roulette, c.connectPaths);
   s.guide.misChain = c.mis == Case::Mis::Chain;
   s.guide.learnSelection = c.mis == Case::Mis::Learned;
   const test::BatchEstimate guided =
@@ -124,7 +129,11 @@ INSTANTIATE_TEST_SUITE_P(
                       Case{"two_rooms.gltf", SamplingMode::Mis, 1, RouletteRule::Sqrt, Case::Mis::Chain},
                       Case{"cornell_glossy.gltf", SamplingMode::Mis, 1, RouletteRule::Sqrt, Case::Mis::Chain},
                       Case{"two_rooms.gltf", SamplingMode::Mis, 1, RouletteRule::Sqrt, Case::Mis::Learned},
-                      Case{"cornell_glossy.gltf", SamplingMode::Mis, 0, RouletteRule::Sqrt, Case::Mis::Learned}),
+                      Case{"cornell_glossy.gltf", SamplingMode::Mis, 0, RouletteRule::Sqrt, Case::Mis::Learned},
+                      // VPL connections: off in a guided mode (the paper's setting), on in brdf.
+                      Case{"two_rooms.gltf", SamplingMode::Mis, 1, RouletteRule::Sqrt, Case::Mis::Default, 0},
+                      Case{"door_ajar.gltf", SamplingMode::Brdf, 1, RouletteRule::Sqrt, Case::Mis::Default, 512},
+                      Case{"cornell_glossy.gltf", SamplingMode::Brdf, 1, RouletteRule::Vpl, Case::Mis::Default, 512}),
     [](const auto& info) { return caseName(info.param); });
 
 // The statistic is not blind: BSDF sampling against itself passes, and against itself 5 % brighter

@@ -5,6 +5,7 @@
 #include <tuple>
 #include <tbb/global_control.h>
 #include "render/film/film.h"
+#include "render/integrator/light_vertex_cache.h"
 #include "render/integrator/path_tracer.h"
 #include "render/scene/camera.h"
 #include "render/scene/gltf_loader.h"
@@ -21,8 +22,10 @@ struct Rendered {
   PassStats stats;
 };
 
+// connectPaths > 0: VPL connections to that many light paths per pass.
 Rendered renderScene(const RenderScene& scene, int width, int height, int spp, uint64_t seed, int maxDepth = 64,
-                     RouletteRule roulette = PathTracerSettings{}.roulette, int rrStart = PathTracerSettings{}.rrStartDepth) {
+                     RouletteRule roulette = PathTracerSettings{}.roulette, int rrStart = PathTracerSettings{}.rrStartDepth,
+                     int connectPaths = 0) {
   const Camera camera(defaultCamera(scene.data()), width, height);
   PathTracerSettings settings;
   settings.maxDepth = maxDepth;
@@ -30,11 +33,15 @@ Rendered renderScene(const RenderScene& scene, int width, int height, int spp, u
   settings.rrStartDepth = rrStart;
   IrradianceGrid irradiance;
   if (roulette == RouletteRule::Vpl) irradiance = IrradianceGrid(scene, 1 << 16, seed, maxDepth);
-  const PathTracer tracer(scene, settings, &irradiance);
+  LightVertexCache connections;
+  const PathTracer tracer(scene, settings, &irradiance, connectPaths > 0 ? &connections : nullptr);
   const TileRenderer renderer(camera, seed, pathTracerShader(tracer));
   Film film(width, height);
   Rendered r;
-  for (int pass = 0; pass < spp; ++pass) r.stats += renderer.renderPass(film, uint64_t(pass));
+  for (int pass = 0; pass < spp; ++pass) {
+    if (connectPaths > 0) connections.build(scene, seed, uint64_t(pass), connectPaths, maxDepth - 1);
+    r.stats += renderer.renderPass(film, uint64_t(pass));
+  }
   r.image = film.resolve();
   return r;
 }
@@ -84,6 +91,26 @@ INSTANTIATE_TEST_SUITE_P(AlbedosAndRoulette, WhiteFurnace,
                                             ::testing::Values(1, 5)),
                          furnaceName);
 
+// VPL connections: every path is made by BSDF sampling, next-event estimation and a join at each
+// vertex, and the MIS weights of all of them must sum to 1, or the furnace's answer moves. Depth 3
+// also checks that no join makes a path longer than the limit (the answer is then the series'
+// first four terms).
+TEST(WhiteFurnace, ConvergesWithVplConnections) {
+  const float le = 0.5f;
+  for (const float rho : {0.5f, 0.8f}) {
+    for (const int depth : {3, 1024}) {
+      const RenderScene scene(test::furnaceScene(rho, le));
+      const Rendered r = renderScene(scene, 32, 32, 64, 11, depth, RouletteRule::Sqrt, 5, 512);
+      const double expected = depth == 3 ? le * (1.0 + rho + rho * rho + rho * rho * rho) : le / (1.0 - rho);
+      for (int c = 0; c < 3; ++c) {
+        const MeanAndError m = channelMean(r.image, c);
+        EXPECT_NEAR(m.mean, expected, 4.0 * m.error + 1e-3 * expected) << "rho " << rho << " depth " << depth << " channel " << c;
+      }
+      EXPECT_EQ(r.stats.discarded, 0u);
+    }
+  }
+}
+
 TEST(WhiteFurnace, GlossyMetalNeverGainsEnergy) {
   // A perfect-white rough metal reflects at most what it receives: radiance <= le / (1 - 1) is
   // unbounded, so bound it by the path length instead: L <= le * (depth + 1).
@@ -101,17 +128,19 @@ TEST(WhiteFurnace, GlossyMetalNeverGainsEnergy) {
 
 TEST(PathTracer, SameSeedSameImageForAnyThreadCount) {
   const RenderScene scene(test::furnaceScene(0.7f, 1.0f));
-  Image one, two;
-  {
-    tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
-    one = renderScene(scene, 24, 20, 4, 5).image;
+  for (const int connectPaths : {0, 700}) {  // with VPL connections, the light vertices too
+    Image one, two;
+    {
+      tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
+      one = renderScene(scene, 24, 20, 4, 5, 64, PathTracerSettings{}.roulette, 5, connectPaths).image;
+    }
+    {
+      tbb::global_control c(tbb::global_control::max_allowed_parallelism, 2);
+      two = renderScene(scene, 24, 20, 4, 5, 64, PathTracerSettings{}.roulette, 5, connectPaths).image;
+    }
+    ASSERT_EQ(one.pixels.size(), two.pixels.size());
+    for (size_t i = 0; i < one.pixels.size(); ++i) ASSERT_EQ(one.pixels[i], two.pixels[i]) << "pixel " << i << " paths " << connectPaths;
   }
-  {
-    tbb::global_control c(tbb::global_control::max_allowed_parallelism, 2);
-    two = renderScene(scene, 24, 20, 4, 5).image;
-  }
-  ASSERT_EQ(one.pixels.size(), two.pixels.size());
-  for (size_t i = 0; i < one.pixels.size(); ++i) ASSERT_EQ(one.pixels[i], two.pixels[i]) << "pixel " << i;
 }
 
 }  // namespace
