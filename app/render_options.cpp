@@ -76,7 +76,7 @@ void RenderOptions::addCommonTo(CLI::App& command) {
       ->check(CLI::Range(1, 1024));
   command.add_option("--connect-paths", connections.paths,
                      "VPL connections: light paths traced per pass, whose vertices every camera vertex joins by "
-                     "bidirectional MIS (0: none; -1: a quarter of the pixels in the guided modes, none in brdf)")
+                     "bidirectional MIS (0: none; -1: a 32nd of the pixels, 1024 to 8192, in the guided modes, none in brdf)")
       ->check(CLI::Range(-1, 1 << 24));
   command.add_option("--sky", sky, "uniform sky radiance R,G,B; 0 turns it off (default: on only without lights)");
   command.add_option("--exposure", exposure, "PNG exposure in stops");

@@ -11,7 +11,7 @@ namespace vpl {
 int ConnectionSettings::pathsFor(int pixels, SamplingMode mode) const {
   if (paths >= 0) return paths;
   if (!isGuided(mode)) return 0;
-  return std::clamp(pixels / 4, 4096, 65536);
+  return std::clamp(pixels / 32, 1024, 8192);
 }
 
 std::string ConnectionSettings::validate() const {

@@ -10,7 +10,7 @@
 //
 // Parameters:
 //   paths     per pass (ConnectionSettings::paths): more paths, less correlation between pixels of
-//             one pass, more tracing per pass
+//             one pass, more tracing per pass and a cache that falls out of the CPU's
 //   maxLength most segments of a light subpath (the path tracer's maxDepth - 1)
 #pragma once
 #include <cstdint>
@@ -27,8 +27,10 @@ namespace vpl {
 inline float connectionMis(float ratio) { return ratio * ratio; }
 
 struct ConnectionSettings {
-  // Light paths per pass; 0: no connections; -1 (auto): in the guided modes a quarter of the
-  // pixels, at least 4096, at most 65536 (a pass's cache stays under about 40 MB); none in brdf.
+  // Light paths per pass; 0: no connections; -1 (auto): in the guided modes a 32nd of the pixels,
+  // at least 1024, at most 8192; none in brdf. Fewer paths than that measured faster at the same
+  // error: the joins' random reads stay in cache (door_ajar 320x240 mis 10 s: 19200 paths 57 spp,
+  // relMSE 0.185; 4096 81 spp, 0.137; 1024 83 spp, 0.134).
   int paths = -1;
 
   int pathsFor(int pixels, SamplingMode mode) const;
