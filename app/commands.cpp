@@ -145,6 +145,7 @@ int runViewerCommand() {
   options.session.seed = s.seed;
   options.session.threads = gViewer.threads;
   options.session.tracer = s.tracer;
+  options.session.connections = s.connections;
   options.session.preview = s.preview;
   options.session.guide = s.guide;
   options.sky = s.sky;

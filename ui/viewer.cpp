@@ -74,6 +74,7 @@ struct PanelSettings {
   float defensive;
   float uniformMutation;
   int roulette;  // index into kRoulettes
+  bool connections;  // VPL connections in the guided modes
 };
 
 constexpr RouletteRule kRoulettes[] = {RouletteRule::Auto, RouletteRule::Sqrt, RouletteRule::Throughput, RouletteRule::Vpl};
@@ -137,7 +138,8 @@ int runViewer(const ViewerOptions& options) {
     PanelSettings panel{settings.preview.vpl.count, settings.preview.clustering.clusterBudget,
                         settings.guide.coneAngle * 57.29578f, settings.guide.bsdfProbability, settings.guide.learnSelection,
                         settings.guide.defensive,
-                        settings.guide.uniformMutation, rouletteIndex(settings.tracer.roulette)};
+                        settings.guide.uniformMutation, rouletteIndex(settings.tracer.roulette),
+                        settings.connections.paths != 0};
 
     Image image, variance;
     uint64_t version = 0;
@@ -237,6 +239,7 @@ int runViewer(const ViewerOptions& options) {
           ImGui::SliderFloat("defensive", &panel.defensive, 0.001f, 1.0f);
           ImGui::SliderFloat("uniform mutation", &panel.uniformMutation, 0.0f, 1.0f);
           ImGui::Combo("roulette", &panel.roulette, kRouletteNames, 4);
+          ImGui::Checkbox("VPL connections (guided modes)", &panel.connections);
           if (ImGui::Button("apply (restarts)")) {
             SessionSettings next = settings;
             next.mode = stats.mode;
@@ -250,6 +253,7 @@ int runViewer(const ViewerOptions& options) {
             next.guide.defensive = std::clamp(panel.defensive, 0.001f, 1.0f);
             next.guide.uniformMutation = std::clamp(panel.uniformMutation, 0.0f, 1.0f);
             next.tracer.roulette = kRoulettes[std::clamp(panel.roulette, 0, 3)];
+            if (panel.connections != (settings.connections.paths != 0)) next.connections.paths = panel.connections ? -1 : 0;
             session.reset();  // joins the old controller before the new one starts
             session = std::make_unique<ProgressiveSession>(scene, controller.camera(), next);
             settings = next;

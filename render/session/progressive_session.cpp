@@ -315,15 +315,22 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
     continuation = guidedContinuations(guide, mode, mine.learner.get());
   }
   const RouletteRule rule = settings_.tracer.roulette;
+  // VPL connections: fresh light vertices before every pass, for tracers of this refinement only.
+  const int joinPaths = settings_.connections.pathsFor(w * h, request.mode);
+  LightVertexCache joins;
+  std::optional<PathTracer> joinTracer, joinWindowTracer;
   auto refineTracer = [&]() -> const PathTracer& {
-    if (rule != RouletteRule::Vpl && !(rule == RouletteRule::Auto && mine.window.on())) return tracer_;
-    if (!windowTracer_) {  // once per scene, when a film first asks for it
+    const bool windowed = rule == RouletteRule::Vpl || (rule == RouletteRule::Auto && mine.window.on());
+    if (windowed && !windowTracer_) {  // once per scene, when a film first asks for it
       irradiance_ = std::make_unique<IrradianceGrid>(scene, IrradianceGrid::kPhotons, settings_.seed, settings_.tracer.maxDepth);
-      PathTracerSettings windowed = settings_.tracer;
-      windowed.roulette = RouletteRule::Vpl;
-      windowTracer_ = std::make_unique<PathTracer>(scene, windowed, irradiance_.get());
+      PathTracerSettings window = settings_.tracer;
+      window.roulette = RouletteRule::Vpl;
+      windowTracer_ = std::make_unique<PathTracer>(scene, window, irradiance_.get());
     }
-    return *windowTracer_;
+    if (joinPaths <= 0) return windowed ? *windowTracer_ : tracer_;
+    std::optional<PathTracer>& t = windowed ? joinWindowTracer : joinTracer;
+    if (!t) t.emplace(scene, windowed ? windowTracer_->settings() : settings_.tracer, windowed ? irradiance_.get() : nullptr, &joins);
+    return *t;
   };
   std::optional<TileRenderer> renderer;
   renderer.emplace(camera, settings_.seed, pathTracerShader(refineTracer(), continuation));
@@ -341,6 +348,7 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
   }
   while (mine.complete < settings_.maxSpp) {
     const auto t = Clock::now();
+    if (joinPaths > 0) joins.build(scene, settings_.seed, mine.nextPass, joinPaths, settings_.tracer.maxDepth - 1);
     const PassStats pass = renderer->renderPass(*mine.film, mine.nextPass++, &cancel_);
     state.renderSeconds += secondsSince(t);
     state.samples += pass.samples;

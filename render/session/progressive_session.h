@@ -22,6 +22,7 @@
 #include <thread>
 #include "render/film/image.h"
 #include "render/guide/guide_settings.h"
+#include "render/integrator/light_vertex_cache.h"
 #include "render/integrator/path_tracer.h"
 #include "render/integrator/sampling_mode.h"
 #include "render/scene/camera.h"
@@ -43,6 +44,7 @@ struct SessionSettings {
   int maxSlices = 384;       // slices (cache points) per view at most; 0: preview.slices alone decides
   bool coarsePreview = true;  // show a coarse preview pass before the full clustering
   PathTracerSettings tracer;
+  ConnectionSettings connections;  // VPL connections of the refining passes
   PreviewSettings preview;
   GuideSettings guide;
 };
