@@ -91,6 +91,29 @@ struct PathTracer::Branch {
   float dVC = 0.0f, dVCM = 0.0f;  // connections' MIS partial sums; 0 at the camera: no light tracing to it
 };
 
+float PathTracer::emitterHitWeight(const SurfaceHit& surface, const glm::vec3& wo, const Branch& path) const {
+  if (path.depth == 0) return 1.0f;
+  const EmitterSet& emitters = scene_.emitters();
+  if (!connections_) return powerHeuristic(path.previousPdf, emitters.pdfTriangle(path.previous.position, surface));
+  const glm::vec3 d = surface.position - path.previous.position;
+  const float cosHit = std::abs(glm::dot(surface.geometricNormal, wo));
+  const float directPdfArea = emitters.pdfTriangle(path.previous.position, surface) * cosHit / glm::dot(d, d);
+  return bidirectionalWeight(connectionMis(directPdfArea) * path.dVCM + connectionMis(emitters.pdfEmission(surface, wo)) * path.dVC);
+}
+
+float PathTracer::nextEventWeight(const LightSample& ls, const SurfaceHit& surface, const Bsdf& bsdf, const glm::vec3& wo,
+                                  const Branch& path, ContinuationSampler& continuation) const {
+  if (!connections_) return ls.delta ? 1.0f : powerHeuristic(ls.pdf, continuation.pdf(surface, bsdf, wo, ls.wi));
+  // Densities of punctual lights in the solid angle of the point they sit at (Georgiev 2012).
+  const float directPdf = ls.delta && std::isfinite(ls.distance) ? ls.pdf * ls.distance * ls.distance : ls.pdf;
+  const float wLight = ls.delta ? 0.0f : connectionMis(cameraMisPdf(path.depth, continuation, surface, bsdf, wo, ls.wi) / directPdf);
+  // The light path that starts at the sampled point and reaches here, then shifts along the camera side.
+  const float cameraSide = path.dVCM + path.dVC * connectionMis(bsdf.pdf(ls.wi, wo));
+  const float cosCamera = std::abs(glm::dot(surface.geometricNormal, ls.wi));
+  const float wCamera = cameraSide > 0.0f ? connectionMis(ls.emissionPdf * cosCamera / (directPdf * ls.cosLight)) * cameraSide : 0.0f;
+  return bidirectionalWeight(wLight + wCamera);
+}
+
 glm::vec3 PathTracer::connect(const SurfaceHit& surface, const Bsdf& bsdf, const glm::vec3& wo, const Branch& path,
                               ContinuationSampler& continuation, const LightVertex& y, float scale,
                               PathStats& stats) const {
@@ -153,8 +176,8 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
       const SurfaceHit surface = scene_.surface(ray, hit);
       const glm::vec3 wo = -ray.direction;
       continuation.beginVertex(depth);
-      const float cosHit = std::abs(glm::dot(surface.geometricNormal, wo));
       if (connections_) {
+        const float cosHit = std::abs(glm::dot(surface.geometricNormal, wo));
         if (!(cosHit > 0.0f)) break;
         path.dVCM *= connectionMis(hit.t * hit.t) / connectionMis(cosHit);
         path.dVC /= connectionMis(cosHit);
@@ -164,16 +187,7 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
       // connections, against every join that makes the same path).
       const glm::vec3 le = emitters.emitted(surface, wo);
       if (!isBlack(le)) {
-        float w = 1.0f;
-        if (depth > 0 && connections_) {
-          const glm::vec3 d = surface.position - path.previous.position;
-          const float directPdfArea = emitters.pdfTriangle(path.previous.position, surface) * cosHit / glm::dot(d, d);
-          w = bidirectionalWeight(connectionMis(directPdfArea) * path.dVCM +
-                                  connectionMis(emitters.pdfEmission(surface, wo)) * path.dVC);
-        } else if (depth > 0) {
-          w = powerHeuristic(path.previousPdf, emitters.pdfTriangle(path.previous.position, surface));
-        }
-        L += beta * le * w;
+        L += beta * le * emitterHitWeight(surface, wo, path);
       }
       if (depth + 1 > settings_.maxDepth) break;
 
@@ -213,19 +227,7 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
         if (!isBlack(f) && glm::dot(ls->wi, surface.geometricNormal) > 0.0f) {
           ++stats.rays;
           if (!scene_.accel().occluded(spawnShadowRay(surface, ls->wi, ls->distance))) {
-            float w = 1.0f;
-            if (connections_) {
-              // Densities of punctual lights in the solid angle of the point they sit at (Georgiev 2012).
-              const float directPdf = ls->delta && std::isfinite(ls->distance) ? ls->pdf * ls->distance * ls->distance : ls->pdf;
-              const float wLight = ls->delta ? 0.0f : connectionMis(cameraMisPdf(depth, continuation, surface, bsdf, wo, ls->wi) / directPdf);
-              const float cameraSide = path.dVCM + path.dVC * connectionMis(bsdf.pdf(ls->wi, wo));
-              const float cosCamera = std::abs(glm::dot(surface.geometricNormal, ls->wi));
-              const float wCamera =
-                  cameraSide > 0.0f ? connectionMis(ls->emissionPdf * cosCamera / (directPdf * ls->cosLight)) * cameraSide : 0.0f;
-              w = bidirectionalWeight(wLight + wCamera);
-            } else if (!ls->delta) {
-              w = powerHeuristic(ls->pdf, continuation.pdf(surface, bsdf, wo, ls->wi));
-            }
+            const float w = nextEventWeight(*ls, surface, bsdf, wo, path, continuation);
             L += beta * f * ls->radiance * (w / ls->pdf);
           }
         }

@@ -113,6 +113,11 @@ class PathTracer {
   struct Branch;
   // Radiance reflected at a vertex towards the path, as the VPLs predict it (luminance).
   float predictedRadiance(const SurfaceHit& surface, const Bsdf& bsdf) const;
+  // MIS weights of an emitter hit and of a next-event sample: against each other alone, or with
+  // connections against every join that makes the same path.
+  float emitterHitWeight(const SurfaceHit& surface, const glm::vec3& wo, const Branch& path) const;
+  float nextEventWeight(const LightSample& ls, const SurfaceHit& surface, const Bsdf& bsdf, const glm::vec3& wo,
+                        const Branch& path, ContinuationSampler& continuation) const;
   // The MIS-weighted contribution of joining camera vertex `surface` to light vertex y, picked with
   // weight `scale` (without the path's throughput); 0 when y is too long, faces away or is occluded.
   glm::vec3 connect(const SurfaceHit& surface, const Bsdf& bsdf, const glm::vec3& wo, const Branch& path,
