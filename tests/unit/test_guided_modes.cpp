@@ -38,8 +38,8 @@ RenderJobSettings settings(const std::string& scene, SamplingMode mode, int spp,
   s.guide.guidedVertices = guidedVertices;
   s.tracer.roulette = roulette;
   // VPL connections as the mode has them by default (on in the guided modes), with fewer light
-  // paths than the default's floor of 4096: at 16x12 pixels those would cost more than the pixels.
-  s.connections.paths = connectPaths >= 0 ? connectPaths : isGuided(mode) ? 256 : 0;
+  // paths than the default's floor of 1024: at 16x12 pixels those would cost more than the pixels.
+  s.connections.paths = connectPaths >= 0 ? connectPaths : isGuided(mode) ? 64 : 0;
   return s;
 }
 
@@ -132,8 +132,8 @@ INSTANTIATE_TEST_SUITE_P(
                       Case{"cornell_glossy.gltf", SamplingMode::Mis, 0, RouletteRule::Sqrt, Case::Mis::Learned},
                       // VPL connections: off in a guided mode (the paper's setting), on in brdf.
                       Case{"two_rooms.gltf", SamplingMode::Mis, 1, RouletteRule::Sqrt, Case::Mis::Default, 0},
-                      Case{"door_ajar.gltf", SamplingMode::Brdf, 1, RouletteRule::Sqrt, Case::Mis::Default, 512},
-                      Case{"cornell_glossy.gltf", SamplingMode::Brdf, 1, RouletteRule::Vpl, Case::Mis::Default, 512}),
+                      Case{"door_ajar.gltf", SamplingMode::Brdf, 1, RouletteRule::Sqrt, Case::Mis::Default, 128},
+                      Case{"cornell_glossy.gltf", SamplingMode::Brdf, 1, RouletteRule::Vpl, Case::Mis::Default, 128}),
     [](const auto& info) { return caseName(info.param); });
 
 // The statistic is not blind: BSDF sampling against itself passes, and against itself 5 % brighter
