@@ -9,6 +9,7 @@
 namespace vpl {
 
 int ConnectionSettings::pathsFor(int pixels, SamplingMode mode) const {
+  if (mode == SamplingMode::Preview) return 0;  // no path tracing to join
   if (paths >= 0) return paths;
   if (!isGuided(mode)) return 0;
   return std::clamp(pixels / 32, 1024, 8192);
@@ -90,6 +91,7 @@ void LightVertexCache::build(const RenderScene& scene, uint64_t seed, uint64_t p
   vertices_.clear();
   paths_ = paths;
   rays_ = 0;
+  scale_ = 0.0f;
   if (paths <= 0 || maxLength <= 0 || scene.emitters().empty()) return;
   constexpr int kBatch = 256;
   const int batches = (paths + kBatch - 1) / kBatch;
@@ -107,6 +109,7 @@ void LightVertexCache::build(const RenderScene& scene, uint64_t seed, uint64_t p
     vertices_.insert(vertices_.end(), r.vertices.begin(), r.vertices.end());
     rays_ += r.rays;
   }
+  scale_ = float(vertices_.size()) / float(paths_);
 }
 
 }  // namespace vpl

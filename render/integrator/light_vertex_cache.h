@@ -63,7 +63,7 @@ class LightVertexCache {
   // count over the path count (each camera path sees one light path's worth on average).
   const LightVertex& pick(float u, float& scale) const {
     const size_t i = std::min(vertices_.size() - 1, size_t(u * float(vertices_.size())));
-    scale = float(vertices_.size()) / float(paths_);
+    scale = scale_;
     return vertices_[i];
   }
   uint64_t rays() const { return rays_; }
@@ -71,6 +71,7 @@ class LightVertexCache {
  private:
   std::vector<LightVertex> vertices_;
   int paths_ = 0;
+  float scale_ = 0.0f;  // vertex count over path count
   uint64_t rays_ = 0;
 };
 

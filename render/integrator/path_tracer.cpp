@@ -108,7 +108,7 @@ float PathTracer::nextEventWeight(const LightSample& ls, const SurfaceHit& surfa
   const float directPdf = ls.delta && std::isfinite(ls.distance) ? ls.pdf * ls.distance * ls.distance : ls.pdf;
   const float wLight = ls.delta ? 0.0f : connectionMis(cameraMisPdf(path.depth, continuation, surface, bsdf, wo, ls.wi) / directPdf);
   // The light path that starts at the sampled point and reaches here, then shifts along the camera side.
-  const float cameraSide = path.dVCM + path.dVC * connectionMis(bsdf.pdf(ls.wi, wo));
+  const float cameraSide = path.dVCM + (path.dVC > 0.0f ? path.dVC * connectionMis(bsdf.pdf(ls.wi, wo)) : 0.0f);
   const float cosCamera = std::abs(glm::dot(surface.geometricNormal, ls.wi));
   const float wCamera = cameraSide > 0.0f ? connectionMis(ls.emissionPdf * cosCamera / (directPdf * ls.cosLight)) * cameraSide : 0.0f;
   return bidirectionalWeight(wLight + wCamera);
@@ -131,10 +131,12 @@ glm::vec3 PathTracer::connect(const SurfaceHit& surface, const Bsdf& bsdf, const
   if (isBlack(fLight)) return glm::vec3(0.0f);
   // Each side's density of making the other's end vertex, in area measure at that vertex, times the
   // ways of shifting the join further along that side (the partial sums).
+  // At the first vertex the camera side has no other strategy (no light tracing to the camera): its
+  // densities are not needed.
   const float cameraPdf = cameraMisPdf(path.depth, continuation, surface, bsdf, wo, w);
-  const float lightPdf = y.bsdf.pdf(y.wIn, -w);
   const float wLight = connectionMis(cameraPdf * cosLight / dist2) * (y.dVCM + y.dVC * connectionMis(y.bsdf.pdf(-w, y.wIn)));
-  const float wCamera = connectionMis(lightPdf * cosCamera / dist2) * (path.dVCM + path.dVC * connectionMis(bsdf.pdf(w, wo)));
+  const float cameraSide = path.dVCM + (path.dVC > 0.0f ? path.dVC * connectionMis(bsdf.pdf(w, wo)) : 0.0f);
+  const float wCamera = cameraSide > 0.0f ? connectionMis(y.bsdf.pdf(y.wIn, -w) * cosCamera / dist2) * cameraSide : 0.0f;
   const float weight = bidirectionalWeight(wLight + wCamera);
   if (!(weight > 0.0f)) return glm::vec3(0.0f);
   ++stats.rays;

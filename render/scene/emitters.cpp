@@ -199,7 +199,7 @@ std::optional<LightSample> EmitterSet::sample(const glm::vec3& p, float uLight, 
       if (isBlack(s.radiance)) return std::nullopt;
       s.pdf = float(double(pmf) / st->solidAngle());
       s.cosLight = std::abs(glm::dot(light.normal, s.wi));
-      s.emissionPdf = pmf * s.cosLight / (kPi * light.area * (light.twoSided ? 2.0f : 1.0f));
+      s.emissionPdf = emissionPdf(light, pmf, s.cosLight);
       return s;
     }
     // Sample an emissive triangle by area, convert the density to solid angle at p.
@@ -217,7 +217,7 @@ std::optional<LightSample> EmitterSet::sample(const glm::vec3& p, float uLight, 
     if (isBlack(s.radiance)) return std::nullopt;
     s.pdf = pmf * dist2 / (std::abs(cosLight) * light.area);
     s.cosLight = std::abs(cosLight);
-    s.emissionPdf = pmf * s.cosLight / (kPi * light.area * (light.twoSided ? 2.0f : 1.0f));
+    s.emissionPdf = emissionPdf(light, pmf, s.cosLight);
     return s;
   }
   if (int(index) == skyIndex_) {
@@ -266,14 +266,17 @@ float EmitterSet::pdfTrianglePoint(const glm::vec3& p, size_t index, const glm::
   return distribution_.pmf(index) * dist2 / (cosLight * light.area);
 }
 
+float EmitterSet::emissionPdf(const TriangleLight& light, float pmf, float cosLight) {
+  return pmf * cosLight / (kPi * light.area * (light.twoSided ? 2.0f : 1.0f));
+}
+
 float EmitterSet::pdfEmission(const SurfaceHit& hit, const glm::vec3& direction) const {
   if (hit.mesh >= triangleIndex_.size() || triangleIndex_[hit.mesh].empty()) return 0.0f;
   const int32_t index = triangleIndex_[hit.mesh][hit.triangle];
   if (index < 0) return 0.0f;
   const TriangleLight& light = triangles_[size_t(index)];
   if (!hit.frontFace && !light.twoSided) return 0.0f;
-  const float cosLight = std::abs(glm::dot(hit.geometricNormal, direction));
-  return distribution_.pmf(size_t(index)) * cosLight / (kPi * light.area * (light.twoSided ? 2.0f : 1.0f));
+  return emissionPdf(light, distribution_.pmf(size_t(index)), std::abs(glm::dot(hit.geometricNormal, direction)));
 }
 
 float EmitterSet::nextEventPdfTimesCos(const glm::vec3& p, const EmissionSample& e) const {
@@ -339,7 +342,7 @@ std::optional<EmissionSample> EmitterSet::sampleEmission(float uLight, glm::vec2
     e.normal = n;
     e.direction = Frame::fromNormal(n).toWorld(sampleCosineHemisphere(uDir));
     e.weight = triangleRadiance(light, b, front) * (kPi * light.area * sides / pmf);
-    e.pdf = pmf * std::max(0.0f, glm::dot(n, e.direction)) / (kPi * light.area * sides);
+    e.pdf = emissionPdf(light, pmf, std::max(0.0f, glm::dot(n, e.direction)));
     e.emitter = uint32_t(index);
     return e;
   }

@@ -114,6 +114,9 @@ class EmitterSet {
   // Signed distance from p to the triangle's plane (positive on the front side), or NaN when p lies
   // in that plane as far as the renderer can tell: no light from the triangle reaches p then.
   static float planeDistance(const glm::vec3& p, const TriangleLight& light);
+  // sampleEmission()'s density for a triangle chosen with `pmf`: a uniform point and side, then a
+  // cosine-distributed direction (cosLight: its cosine to the side's normal).
+  static float emissionPdf(const TriangleLight& light, float pmf, float cosLight);
   // pdfTriangle for a point x of light `index`, facing `normal`, on side `front`.
   float pdfTrianglePoint(const glm::vec3& p, size_t index, const glm::vec3& x, const glm::vec3& normal, bool front) const;
 };

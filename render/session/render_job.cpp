@@ -92,8 +92,7 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
     result.vplCount = vpls->vpls.size();
   }
   // VPL connections: fresh light vertices every pass.
-  const int connectionPaths =
-      settings.mode == SamplingMode::Preview ? 0 : settings.connections.pathsFor(settings.width * settings.height, settings.mode);
+  const int connectionPaths = settings.connections.pathsFor(settings.width * settings.height, settings.mode);
   const bool connecting = connectionPaths > 0 && scene.emitters().supportsConnections();
   if (connectionPaths > 0 && !connecting && !scene.emitters().empty())
     result.notices.push_back("VPL connections are off: they do not support the sky or lights with a range");
