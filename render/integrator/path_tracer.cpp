@@ -125,23 +125,23 @@ glm::vec3 PathTracer::connect(const SurfaceHit& surface, const Bsdf& bsdf, const
   const glm::vec3 w = d / dist;
   const float cosCamera = glm::dot(w, surface.geometricNormal), cosLight = -glm::dot(w, y.normal);
   if (!(cosCamera > 0.0f && cosLight > 0.0f)) return glm::vec3(0.0f);
-  const glm::vec3 fCamera = bsdf.eval(wo, w);
-  if (isBlack(fCamera)) return glm::vec3(0.0f);
-  const glm::vec3 fLight = y.bsdf.eval(-w, y.wIn);
-  if (isBlack(fLight)) return glm::vec3(0.0f);
+  const Bsdf::Evaluation camera = bsdf.evalPdf(wo, w);
+  if (isBlack(camera.f)) return glm::vec3(0.0f);
+  const Bsdf::Evaluation light = y.bsdf.evalPdf(-w, y.wIn);
+  if (isBlack(light.f)) return glm::vec3(0.0f);
   // Each side's density of making the other's end vertex, in area measure at that vertex, times the
   // ways of shifting the join further along that side (the partial sums).
   // At the first vertex the camera side has no other strategy (no light tracing to the camera): its
   // densities are not needed.
-  const float cameraPdf = cameraMisPdf(path.depth, continuation, surface, bsdf, wo, w);
-  const float wLight = connectionMis(cameraPdf * cosLight / dist2) * (y.dVCM + y.dVC * connectionMis(y.bsdf.pdf(-w, y.wIn)));
+  const float cameraPdf = path.depth == 0 ? continuation.pdf(surface, bsdf, wo, w) : camera.pdf;  // cameraMisPdf
+  const float wLight = connectionMis(cameraPdf * cosLight / dist2) * (y.dVCM + y.dVC * connectionMis(light.pdf));
   const float cameraSide = path.dVCM + (path.dVC > 0.0f ? path.dVC * connectionMis(bsdf.pdf(w, wo)) : 0.0f);
   const float wCamera = cameraSide > 0.0f ? connectionMis(y.bsdf.pdf(y.wIn, -w) * cosCamera / dist2) * cameraSide : 0.0f;
   const float weight = bidirectionalWeight(wLight + wCamera);
   if (!(weight > 0.0f)) return glm::vec3(0.0f);
   ++stats.rays;
   if (scene_.accel().occluded(spawnShadowRay(surface, w, dist))) return glm::vec3(0.0f);
-  return fCamera * fLight * y.alpha * (cosLight / dist2 * scale * weight);
+  return camera.f * light.f * y.alpha * (cosLight / dist2 * scale * weight);
 }
 
 glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, ContinuationSampler& continuation,
@@ -225,8 +225,8 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
 
       // Next-event estimation: one light sample, MIS with the continuation strategy.
       if (const auto ls = emitters.sample(surface.position, u.lightChoice(), u.lightPoint())) {
-        const glm::vec3 f = bsdf.eval(wo, ls->wi);
-        if (!isBlack(f) && glm::dot(ls->wi, surface.geometricNormal) > 0.0f) {
+        const glm::vec3 f = glm::dot(ls->wi, surface.geometricNormal) > 0.0f ? bsdf.eval(wo, ls->wi) : glm::vec3(0.0f);
+        if (!isBlack(f)) {
           ++stats.rays;
           if (!scene_.accel().occluded(spawnShadowRay(surface, ls->wi, ls->distance))) {
             const float w = nextEventWeight(*ls, surface, bsdf, wo, path, continuation);

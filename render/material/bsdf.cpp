@@ -107,6 +107,12 @@ float Bsdf::pdf(const glm::vec3& wo, const glm::vec3& wi) const {
   return pdfLocal(outgoing(wo), frame_.toLocal(wi));
 }
 
+Bsdf::Evaluation Bsdf::evalPdf(const glm::vec3& wo, const glm::vec3& wi) const {
+  const Outgoing o = outgoing(wo);
+  const glm::vec3 local = frame_.toLocal(wi);
+  return {evalLocal(o, local), pdfLocal(o, local)};
+}
+
 std::optional<BsdfSample> Bsdf::sample(const glm::vec3& woWorld, glm::vec2 u, float uLobe) const {
   const Outgoing o = outgoing(woWorld);
   if (o.local.z <= 0.0f) return std::nullopt;
@@ -130,6 +136,11 @@ std::optional<BsdfSample> Bsdf::sampleLobe(const Outgoing& o, glm::vec2 u, bool 
     wi = 2.0f * glm::dot(wo, h) * h - wo;
   } else {
     wi = sampleCosineHemisphere(u);
+    if (!hasSpecular()) {
+      // A lone Lambertian lobe sampled by its cosine: f cos / pdf is its albedo, no evaluation needed.
+      if (!(wi.z > 0.0f)) return std::nullopt;
+      return BsdfSample{glm::normalize(frame_.toWorld(wi)), params_.diffuse, wi.z * kInvPi};
+    }
   }
   if (wi.z <= 0.0f) return std::nullopt;
   const float pdf = pdfLocal(o, wi);

@@ -51,6 +51,13 @@ class Bsdf {
   glm::vec3 eval(const glm::vec3& wo, const glm::vec3& wi) const;
   // Density of sample() per unit solid angle.
   float pdf(const glm::vec3& wo, const glm::vec3& wi) const;
+  // Both at once, from one change of frame and one set of wo's terms: a bidirectional join needs
+  // them at a vertex whose BSDF is not bound to that wo.
+  struct Evaluation {
+    glm::vec3 f{0.0f};
+    float pdf = 0.0f;
+  };
+  Evaluation evalPdf(const glm::vec3& wo, const glm::vec3& wi) const;
   // Picks a lobe with uLobe, then samples it (GGX: visible normals, Heitz 2018). Empty if no direction.
   std::optional<BsdfSample> sample(const glm::vec3& wo, glm::vec2 u, float uLobe) const;
   // The same from one 2D number: u.x picks the lobe and, rescaled within that lobe's share, serves
