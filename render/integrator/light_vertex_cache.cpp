@@ -5,6 +5,7 @@
 #include <tbb/parallel_for.h>
 #include "render/core/color.h"
 #include "render/sampling/rng.h"
+#include "render/vpl/light_walk.h"
 
 namespace vpl {
 
@@ -29,60 +30,30 @@ struct PathVertices {
 
 void traceLightSubpath(const RenderScene& scene, uint64_t key, int maxLength, PathVertices& out) {
   Rng rng = Rng::hashed(key);
-  const float uLight = rng.uniform();
-  const glm::vec2 uPos = rng.uniform2(), uDir = rng.uniform2();
-  const auto e = scene.emitters().sampleEmission(uLight, uPos, uDir);
-  if (!e || !(e->pdf > 0.0f) || !isFiniteNonNegative(e->weight) || isBlack(e->weight)) return;
-  const bool onSurface = e->normal != glm::vec3(0.0f);
+  const auto e = startLightPath(scene, rng);
+  if (!e) return;
   // A light that no ray can hit (a point, a direction) has no strategy that reaches its start by
   // BSDF sampling: dVC starts at 0.
-  float dVC = onSurface ? connectionMis(glm::dot(e->normal, e->direction) / e->pdf) : 0.0f;
+  float dVC = e->normal != glm::vec3(0.0f) ? connectionMis(glm::dot(e->normal, e->direction) / e->pdf) : 0.0f;
   float dVCM = 0.0f;
-  glm::vec3 throughput = e->weight;
-  const float startMax = maxComponent(e->weight);
-
-  Ray ray;
-  ray.origin = onSurface ? offsetRayOrigin(e->position, e->normal, scene.coordinateScale()) : e->position;
-  ray.direction = e->direction;
-  for (int length = 1; length <= maxLength; ++length) {
-    const RayHit hit = scene.accel().intersect(ray);
-    ++out.rays;
-    if (!hit.valid()) break;
-    const SurfaceHit surface = scene.surface(ray, hit);
-    const glm::vec3 wIn = -ray.direction;
-    const float cosIn = std::abs(glm::dot(surface.geometricNormal, wIn));
-    if (!(cosIn > 0.0f)) break;
-    if (length == 1) {
+  const auto onVertex = [&](const LightWalkVertex& v) {
+    const float cosIn = std::abs(glm::dot(v.surface.geometricNormal, v.wIn));
+    if (v.length == 1) {
       // Next-event estimation from here would have picked the start with a density of its own.
-      dVCM = connectionMis(scene.emitters().nextEventPdfTimesCos(surface.position, *e) / (e->pdf * cosIn));
+      dVCM = connectionMis(scene.emitters().nextEventPdfTimesCos(v.surface.position, *e) / (e->pdf * cosIn));
     } else {
-      dVCM *= connectionMis(hit.t * hit.t) / connectionMis(cosIn);
+      dVCM *= connectionMis(v.distance * v.distance) / connectionMis(cosIn);
     }
     dVC /= connectionMis(cosIn);
-    const Bsdf bsdf = scene.bsdf(surface, wIn);
-    out.vertices.push_back({surface.position, surface.geometricNormal, wIn, throughput / cosIn, dVC, dVCM, length, bsdf});
-    if (length == maxLength) break;
-
-    const auto s = bsdf.sample(wIn, rng.uniform2());
-    if (!s || !(s->pdf > 0.0f)) break;
-    const float cosOut = glm::dot(surface.geometricNormal, s->wi);
-    if (!(cosOut > 0.0f)) break;  // reflection only, as the camera side
-    // weight = f |Ns.wOut| / pdf; light flows the other way, so its shading-normal cosine is the
-    // arriving one (Veach 1997, §5.3: the adjoint BSDF with shading normals).
-    const float nsIn = std::abs(glm::dot(surface.shadingNormal, wIn)), nsOut = std::abs(glm::dot(surface.shadingNormal, s->wi));
-    if (!(nsOut > 0.0f)) break;
-    throughput *= s->weight * (nsIn * cosOut / (nsOut * cosIn));
-    const float reversePdf = bsdf.pdf(s->wi, wIn);
-    dVC = connectionMis(cosOut / s->pdf) * (dVC * connectionMis(reversePdf) + dVCM);
-    dVCM = connectionMis(1.0f / s->pdf);
-    // Russian roulette keeps the throughput near where it started (not counted in the MIS weights:
-    // they sum to 1 whatever it does).
-    const float survive = std::min(1.0f, maxComponent(throughput) / std::max(1e-30f, startMax));
-    if (rng.uniform() >= survive) break;
-    throughput /= survive;
-    if (!isFiniteNonNegative(throughput)) break;
-    ray = spawnRay(surface, s->wi);
-  }
+    out.vertices.push_back({v.surface.position, v.surface.geometricNormal, v.wIn, v.throughput / cosIn, dVC, dVCM, v.length, v.bsdf});
+    return true;
+  };
+  // Roulette is not counted in the MIS weights: they sum to 1 whatever it does.
+  const auto onScatter = [&](const LightWalkVertex& v, const BsdfSample& s, float cosOut) {
+    dVC = connectionMis(cosOut / s.pdf) * (dVC * connectionMis(v.bsdf.pdf(s.wi, v.wIn)) + dVCM);
+    dVCM = connectionMis(1.0f / s.pdf);
+  };
+  out.rays += walkLightPath(scene, rng, *e, maxLength, onVertex, onScatter);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 #include "render/core/color.h"
 #include "render/sampling/rng.h"
+#include "render/vpl/light_walk.h"
 
 namespace vpl {
 
@@ -24,44 +25,23 @@ struct PathResult {
 void traceLightPath(const RenderScene& scene, const VplSettings& settings, uint64_t pathIndex, PathResult& out) {
   // A light path takes an unbounded count of numbers: its own hashed random stream.
   Rng rng = Rng::hashed(mix64(settings.seed ^ 0x5bd1e995ull) ^ pathIndex);
-  const float uLight = rng.uniform();
-  const glm::vec2 uPos = rng.uniform2(), uDir = rng.uniform2();
-  const auto emission = scene.emitters().sampleEmission(uLight, uPos, uDir);
-  if (!emission || !isFiniteNonNegative(emission->weight) || isBlack(emission->weight)) return;
-
-  glm::vec3 beta = emission->weight;
-  Ray ray;
-  ray.origin = emission->normal == glm::vec3(0.0f) ? emission->position
-                                                   : offsetRayOrigin(emission->position, emission->normal, scene.coordinateScale());
-  ray.direction = emission->direction;
-  for (int depth = 1; depth <= settings.maxDepth; ++depth) {
-    const RayHit hit = scene.accel().intersect(ray);
-    ++out.rays;
-    if (!hit.valid()) break;
-    const SurfaceHit surface = scene.surface(ray, hit);
-    const glm::vec3 wo = -ray.direction;
-    const Bsdf bsdf = scene.bsdf(surface, wo);
-    if (!bsdf.isNearSpecular()) {
-      Vpl v;
-      v.position = surface.position;
-      v.normal = surface.shadingNormal;
-      v.flux = beta;
-      v.incident = wo;
-      v.bsdf = bsdf;
-      v.material = surface.material;
-      v.bounce = uint16_t(std::min(depth, 65535));
-      out.vpls.push_back(v);
+  const auto emission = startLightPath(scene, rng);
+  if (!emission) return;
+  const auto leaveVpl = [&](const LightWalkVertex& v) {
+    if (!v.bsdf.isNearSpecular()) {
+      Vpl vpl;
+      vpl.position = v.surface.position;
+      vpl.normal = v.surface.shadingNormal;
+      vpl.flux = v.throughput;
+      vpl.incident = v.wIn;
+      vpl.bsdf = v.bsdf;
+      vpl.material = v.surface.material;
+      vpl.bounce = uint16_t(std::min(v.length, 65535));
+      out.vpls.push_back(vpl);
     }
-    const auto s = bsdf.sample(wo, rng.uniform2(), rng.uniform());
-    if (!s) break;
-    beta *= s->weight;
-    // Russian roulette keeps VPL fluxes bounded (beta stays <= its running maximum).
-    const float survive = std::min(1.0f, maxComponent(beta) / std::max(1e-30f, maxComponent(emission->weight)));
-    if (rng.uniform() >= survive) break;
-    beta /= survive;
-    if (!isFiniteNonNegative(beta)) break;
-    ray = spawnRay(surface, s->wi);
-  }
+    return true;
+  };
+  out.rays += walkLightPath(scene, rng, *emission, settings.maxDepth, leaveVpl, [](const LightWalkVertex&, const BsdfSample&, float) {});
 }
 
 }  // namespace

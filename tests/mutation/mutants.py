@@ -62,7 +62,7 @@ MUTANTS = [
      "const glm::vec3 branchBeta = beta;",
      "a split path's branches each carry the whole weight"),
     ("connection-weights-miss-light-side", "render/integrator/path_tracer.cpp",
-     "(y.dVCM + y.dVC * connectionMis(y.bsdf.pdf(-w, y.wIn)));",
+     "(y.dVCM + y.dVC * connectionMis(light.pdf));",
      "(y.dVCM);",
      "VPL connections' MIS weights forget the strategies that join further along the light path"),
     ("connection-one-segment-too-long", "render/integrator/path_tracer.cpp",
