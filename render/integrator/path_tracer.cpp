@@ -133,7 +133,8 @@ glm::vec3 PathTracer::connect(const SurfaceHit& surface, const Bsdf& bsdf, const
   // ways of shifting the join further along that side (the partial sums).
   // At the first vertex the camera side has no other strategy (no light tracing to the camera): its
   // densities are not needed.
-  const float cameraPdf = path.depth == 0 ? continuation.pdf(surface, bsdf, wo, w) : camera.pdf;  // cameraMisPdf
+  // cameraMisPdf, with the BSDF's density taken from the evaluation above.
+  const float cameraPdf = path.depth == 0 ? continuation.pdf(surface, bsdf, wo, w) : camera.pdf;
   const float wLight = connectionMis(cameraPdf * cosLight / dist2) * (y.dVCM + y.dVC * connectionMis(light.pdf));
   const float cameraSide = path.dVCM + (path.dVC > 0.0f ? path.dVC * connectionMis(bsdf.pdf(w, wo)) : 0.0f);
   const float wCamera = cameraSide > 0.0f ? connectionMis(y.bsdf.pdf(y.wIn, -w) * cosCamera / dist2) * cameraSide : 0.0f;
