@@ -63,7 +63,8 @@ void LightVertexCache::build(const RenderScene& scene, uint64_t seed, uint64_t p
   paths_ = paths;
   rays_ = 0;
   scale_ = 0.0f;
-  if (paths <= 0 || maxLength <= 0 || scene.emitters().empty()) return;
+  // No vertices where the tracer could not weight its joins (PathTracer ignores the cache there).
+  if (paths <= 0 || maxLength <= 0 || !scene.emitters().supportsConnections() || scene.emitters().empty()) return;
   constexpr int kBatch = 256;
   const int batches = (paths + kBatch - 1) / kBatch;
   std::vector<PathVertices> results(static_cast<size_t>(batches));

@@ -54,7 +54,7 @@ class LightVertexCache {
  public:
   // Traces `paths` light paths of pass `pass`, each with numbers of its own hashed from (seed,
   // pass, path): the cache depends on nothing else (not threads). Subpaths end after maxLength
-  // segments or by Russian roulette.
+  // segments or by Russian roulette. Empty for lights that connections do not support.
   void build(const RenderScene& scene, uint64_t seed, uint64_t pass, int paths, int maxLength);
 
   bool empty() const { return vertices_.empty(); }

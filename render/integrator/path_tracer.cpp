@@ -131,9 +131,9 @@ glm::vec3 PathTracer::connect(const SurfaceHit& surface, const Bsdf& bsdf, const
   if (isBlack(light.f)) return glm::vec3(0.0f);
   // Each side's density of making the other's end vertex, in area measure at that vertex, times the
   // ways of shifting the join further along that side (the partial sums).
-  // At the first vertex the camera side has no other strategy (no light tracing to the camera): its
-  // densities are not needed.
-  // cameraMisPdf, with the BSDF's density taken from the evaluation above.
+  // The camera's density is cameraMisPdf's, with the BSDF's taken from the evaluation above. At the
+  // first vertex the camera side has no other strategy (no light tracing to the camera): cameraSide
+  // is 0 and its densities are not needed.
   const float cameraPdf = path.depth == 0 ? continuation.pdf(surface, bsdf, wo, w) : camera.pdf;
   const float wLight = connectionMis(cameraPdf * cosLight / dist2) * (y.dVCM + y.dVC * connectionMis(light.pdf));
   const float cameraSide = path.dVCM + (path.dVC > 0.0f ? path.dVC * connectionMis(bsdf.pdf(w, wo)) : 0.0f);

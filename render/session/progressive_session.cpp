@@ -316,8 +316,7 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
   }
   const RouletteRule rule = settings_.tracer.roulette;
   // VPL connections: fresh light vertices before every pass, for tracers of this refinement only.
-  // A scene whose lights connections do not support traces no light vertices (the tracer would ignore them).
-  const int joinPaths = scene.emitters().supportsConnections() ? settings_.connections.pathsFor(w * h, request.mode) : 0;
+  const int joinPaths = settings_.connections.pathsFor(w * h, request.mode);
   LightVertexCache joins;
   std::optional<PathTracer> joinTracer, joinWindowTracer;
   auto refineTracer = [&]() -> const PathTracer& {
