@@ -78,6 +78,11 @@ void RenderOptions::addCommonTo(CLI::App& command) {
                      "VPL connections: light paths traced per pass, whose vertices every camera vertex joins by "
                      "bidirectional MIS (0: none; -1: a 32nd of the pixels, 1024 to 8192, in the guided modes, none in brdf)")
       ->check(CLI::Range(-1, 1 << 24));
+  command.add_option_function<std::string>(
+            "--join-choice", [this](const std::string& v) { connections.learnChoice = v == "learned"; },
+            "VPL connections: which light vertex a camera vertex joins: learned (cells of the scene in proportion to "
+            "what their joins brought back in earlier passes, 30 % uniform) | uniform")
+      ->check(CLI::IsMember({"learned", "uniform"}));
   command.add_option("--sky", sky, "uniform sky radiance R,G,B; 0 turns it off (default: on only without lights)");
   command.add_option("--exposure", exposure, "PNG exposure in stops");
   command.add_option("--vpls", preview.vpl.count, "number of VPLs")->check(CLI::Range(0, 50'000'000));

@@ -45,7 +45,7 @@ void traceLightSubpath(const RenderScene& scene, uint64_t key, int maxLength, Pa
       dVCM *= connectionMis(v.distance * v.distance) / connectionMis(cosIn);
     }
     dVC /= connectionMis(cosIn);
-    out.vertices.push_back({v.surface.position, v.surface.geometricNormal, v.wIn, v.throughput / cosIn, dVC, dVCM, v.length, v.bsdf});
+    out.vertices.push_back({v.surface.position, v.surface.geometricNormal, v.wIn, v.throughput / cosIn, dVC, dVCM, v.length, 0u, v.bsdf});
     return true;
   };
   // Roulette is not counted in the MIS weights: they sum to 1 whatever it does.
@@ -59,10 +59,17 @@ void traceLightSubpath(const RenderScene& scene, uint64_t key, int maxLength, Pa
 }  // namespace
 
 void LightVertexCache::build(const RenderScene& scene, uint64_t seed, uint64_t pass, int paths, int maxLength) {
+  // What the joins of the last pass brought back joins the sums of the passes before it.
+  for (int k = 0; k < kCells; ++k)
+    learned_[size_t(k)] += double(pending_[size_t(k)].exchange(0, std::memory_order_relaxed)) / double(kFixedPoint);
   vertices_.clear();
-  paths_ = paths;
+  cellOf_.clear();
+  cellStart_.clear();
+  cellCount_.clear();
+  cellCdf_.clear();
+  cellScale_.clear();
   rays_ = 0;
-  scale_ = 0.0f;
+  learnedShare_ = 0.0f;
   // No vertices where the tracer could not weight its joins (PathTracer ignores the cache there).
   if (paths <= 0 || maxLength <= 0 || !scene.emitters().supportsConnections() || scene.emitters().empty()) return;
   constexpr int kBatch = 256;
@@ -74,14 +81,60 @@ void LightVertexCache::build(const RenderScene& scene, uint64_t seed, uint64_t p
     const int end = std::min(paths, (b + 1) * kBatch);
     for (int i = b * kBatch; i < end; ++i) traceLightSubpath(scene, mix64(passKey ^ uint64_t(i)), maxLength, results[size_t(b)]);
   });
+  std::vector<LightVertex> traced;
   size_t total = 0;
   for (const PathVertices& r : results) total += r.vertices.size();
-  vertices_.reserve(total);
+  traced.reserve(total);
   for (PathVertices& r : results) {
-    vertices_.insert(vertices_.end(), r.vertices.begin(), r.vertices.end());
+    traced.insert(traced.end(), r.vertices.begin(), r.vertices.end());
     rays_ += r.rays;
   }
-  scale_ = float(vertices_.size()) / float(paths_);
+  if (traced.empty()) return;
+  sortIntoCells(scene, std::move(traced));
+  chooseCells(paths);
+}
+
+void LightVertexCache::sortIntoCells(const RenderScene& scene, std::vector<LightVertex>&& traced) {
+  const glm::vec3 low = scene.data().boundsMin;
+  const glm::vec3 perUnit = float(kCellsPerAxis) / glm::max(scene.data().boundsMax - low, glm::vec3(1e-20f));
+  std::vector<uint32_t> count(kCells, 0);
+  for (LightVertex& v : traced) {
+    const glm::ivec3 c = glm::clamp(glm::ivec3(glm::clamp((v.position - low) * perUnit, 0.0f, float(kCellsPerAxis))),
+                                    glm::ivec3(0), glm::ivec3(kCellsPerAxis - 1));
+    v.cell = uint32_t((c.z * kCellsPerAxis + c.y) * kCellsPerAxis + c.x);
+    ++count[v.cell];
+  }
+  // A counting sort, stable: the order within a cell stays the path order.
+  std::vector<uint32_t> next(kCells, 0);
+  for (uint32_t k = 0, start = 0; k < uint32_t(kCells); start += count[k++]) {
+    next[k] = start;
+    if (count[k] == 0) continue;
+    cellOf_.push_back(k);
+    cellStart_.push_back(start);
+    cellCount_.push_back(count[k]);
+  }
+  vertices_.resize(traced.size());
+  for (LightVertex& v : traced) vertices_[next[v.cell]++] = std::move(v);
+}
+
+void LightVertexCache::chooseCells(int paths) {
+  double learnedTotal = 0.0;
+  for (const uint32_t k : cellOf_) learnedTotal += learned_[k];
+  const double learned = learnChoice_ && learnedTotal > 0.0 ? 1.0 - double(kUniformShare) : 0.0;
+  learnedShare_ = float(learned);
+  const double count = double(vertices_.size());
+  double cumulative = 0.0;
+  for (size_t c = 0; c < cellOf_.size(); ++c) {
+    cumulative += (1.0 - learned) * double(cellCount_[c]) / count;
+    if (learned > 0.0) cumulative += learned * learned_[cellOf_[c]] / learnedTotal;
+    cellCdf_.push_back(float(cumulative));
+  }
+  cellCdf_.back() = 1.0f;
+  // The scale from the probability the float cumulative sums actually give each cell.
+  for (size_t c = 0; c < cellOf_.size(); ++c) {
+    const double width = double(cellCdf_[c]) - (c > 0 ? double(cellCdf_[c - 1]) : 0.0);
+    cellScale_.push_back(width > 0.0 ? float(double(cellCount_[c]) / (width * double(paths))) : 0.0f);
+  }
 }
 
 }  // namespace vpl

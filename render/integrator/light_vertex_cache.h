@@ -1,18 +1,30 @@
 // VPL connections: the light vertices a camera path connects to (bidirectional path tracing with a
 // light vertex cache, Davidovič et al. 2014). Each pass traces fresh light paths from the emitters,
 // as instant radiosity does for its VPLs, and keeps every vertex they reach. A camera vertex joins
-// one of them, chosen uniformly; multiple importance sampling (the balance of all ways to make a
+// one of them (see "Which vertex" below); multiple importance sampling (the balance of all ways to make a
 // path: BSDF sampling, next-event estimation, connection at each vertex; power heuristic) weights
 // each connection, so the VPLs carry the light that reaches the camera's room through a door while
 // the short connections, which instant radiosity clamps, are left to the other strategies: no bias.
 // The MIS weights follow the recursive form of Georgiev's "Implementing Vertex Connection and
 // Merging" (2012), without merging and without light tracing to the camera.
 //
+// Which vertex: Davidovič et al. pick uniformly. Where the light reaches the camera's room only
+// through a slit, nearly every such join is occluded (door_ajar: 4 % of joins arrive). So the
+// scene's box is cut into cells, and a join picks a cell in proportion to what joins to that cell's
+// vertices brought back in the earlier passes of the film (each an estimate of the cell's whole
+// contribution: the join's value over its pick probability), mixed with the uniform choice
+// (kUniformShare, so that no vertex's probability falls below that share of uniform's), then a
+// vertex of the cell uniformly. The join divides by the probability it was actually picked with.
+// The MIS weights keep uniform choice's densities: weights only need to sum to 1 over the ways of
+// making a path, and they still do, so the estimate stays unbiased; they are merely not re-tuned.
+//
 // Parameters:
 //   paths     per pass (ConnectionSettings::paths): more paths, less correlation between pixels of
 //             one pass, more tracing per pass and a cache that falls out of the CPU's
 //   maxLength most segments of a light subpath (the path tracer's maxDepth - 1)
 #pragma once
+#include <algorithm>
+#include <atomic>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -32,6 +44,8 @@ struct ConnectionSettings {
   // error: the joins' random reads stay in cache (door_ajar 320x240 mis 10 s: 19200 paths 57 spp,
   // relMSE 0.185; 4096 81 spp, 0.137; 1024 83 spp, 0.134).
   int paths = -1;
+  // Joins pick vertices by what their cells brought back (true) or uniformly (false).
+  bool learnChoice = true;
 
   int pathsFor(int pixels, SamplingMode mode) const;
   std::string validate() const;
@@ -47,31 +61,65 @@ struct LightVertex {
   glm::vec3 alpha{0.0f};
   float dVC = 0.0f, dVCM = 0.0f;  // the MIS partial sums (Georgiev 2012) at this vertex
   int length = 0;                 // segments from the light
+  uint32_t cell = 0;              // the cache's cell of position
   Bsdf bsdf;
 };
 
 class LightVertexCache {
  public:
+  static constexpr int kCellsPerAxis = 8;
+  static constexpr float kUniformShare = 0.3f;
+
+  explicit LightVertexCache(bool learnChoice = true) : learnChoice_(learnChoice) {}
+
   // Traces `paths` light paths of pass `pass`, each with numbers of its own hashed from (seed,
-  // pass, path): the cache depends on nothing else (not threads). Subpaths end after maxLength
-  // segments or by Russian roulette. Empty for lights that connections do not support.
+  // pass, path), and takes what the joins of the earlier passes recorded into the cells' choice: the
+  // cache depends on nothing else (not threads). Subpaths end after maxLength segments or by Russian
+  // roulette. Empty for lights that connections do not support.
   void build(const RenderScene& scene, uint64_t seed, uint64_t pass, int paths, int maxLength);
 
   bool empty() const { return vertices_.empty(); }
   const std::vector<LightVertex>& vertices() const { return vertices_; }
-  // One uniformly chosen vertex stands for all of them: its contribution is scaled by the vertex
-  // count over the path count (each camera path sees one light path's worth on average).
+  // The vertex for the number u in [0, 1); scale is one over its pick probability times the path
+  // count (each camera vertex stands for one light path's worth of joins).
   const LightVertex& pick(float u, float& scale) const {
-    const size_t i = std::min(vertices_.size() - 1, size_t(u * float(vertices_.size())));
-    scale = scale_;
-    return vertices_[i];
+    const size_t c = std::min(cellCdf_.size() - 1,
+                              size_t(std::upper_bound(cellCdf_.begin(), cellCdf_.end(), u) - cellCdf_.begin()));
+    const float low = c > 0 ? cellCdf_[c - 1] : 0.0f, width = cellCdf_[c] - low;
+    const uint32_t n = cellCount_[c];
+    const uint32_t i = std::min(n - 1, uint32_t(std::max(0.0f, (u - low) / width) * float(n)));
+    scale = cellScale_[c];
+    return vertices_[cellStart_[c] + i];
+  }
+  // What a join to y brought back (luminance, with every factor of the estimate): the next passes
+  // pick y's cell by it. Any thread, any order: the sums are integers, so the next passes' choice
+  // does not depend on the schedule.
+  void record(const LightVertex& y, float contribution) const {
+    if (!learnChoice_ || !(contribution > 0.0f)) return;
+    const float clamped = std::min(contribution, kLargestRecord);  // a rare spike must not overflow the sum
+    pending_[y.cell].fetch_add(uint64_t(clamped * kFixedPoint), std::memory_order_relaxed);
   }
   uint64_t rays() const { return rays_; }
+  // The share of picks that go to the cells' learned choice rather than the uniform one (0 before
+  // anything is learned or without learning).
+  float learnedShare() const { return learnedShare_; }
 
  private:
-  std::vector<LightVertex> vertices_;
-  int paths_ = 0;
-  float scale_ = 0.0f;  // vertex count over path count
+  static constexpr int kCells = kCellsPerAxis * kCellsPerAxis * kCellsPerAxis;
+  static constexpr float kFixedPoint = 1048576.0f;  // 2^20: records are summed as integers
+  static constexpr float kLargestRecord = 1024.0f;
+
+  void sortIntoCells(const RenderScene& scene, std::vector<LightVertex>&& traced);
+  void chooseCells(int paths);
+
+  bool learnChoice_;
+  std::vector<LightVertex> vertices_;  // grouped by cell
+  // The non-empty cells: their first vertex, vertex count, pick probabilities (cumulative) and scale.
+  std::vector<uint32_t> cellOf_, cellStart_, cellCount_;
+  std::vector<float> cellCdf_, cellScale_;
+  std::vector<double> learned_ = std::vector<double>(kCells, 0.0);  // every pass so far, per cell
+  mutable std::vector<std::atomic<uint64_t>> pending_ = std::vector<std::atomic<uint64_t>>(kCells);  // this pass
+  float learnedShare_ = 0.0f;
   uint64_t rays_ = 0;
 };
 

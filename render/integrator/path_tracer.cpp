@@ -237,7 +237,11 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
       }
 
       // A join to one light vertex (the VPLs' share of the paths through here).
-      if (joinTo) L += beta * connect(surface, bsdf, wo, path, continuation, *joinTo, joinScale, stats);
+      if (joinTo) {
+        const glm::vec3 joined = beta * connect(surface, bsdf, wo, path, continuation, *joinTo, joinScale, stats);
+        connections_->record(*joinTo, luminance(joined));
+        L += joined;
+      }
 
       if (depth == 0) firstContinuationStart = L;
 

@@ -60,6 +60,7 @@ struct ProgressiveSession::CameraState {
     int complete = 0;
     WindowSwitch window;  // the auto roulette rule's decision for this film
     std::unique_ptr<SelectionLearner> learner;  // mis: each cache point's BSDF probability, from this film's passes
+    std::unique_ptr<LightVertexCache> joins;    // VPL connections: its choice of vertices learns from this film's passes
   };
   std::optional<Request> key;
   Clock::time_point restart = Clock::now();
@@ -317,7 +318,7 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
   const RouletteRule rule = settings_.tracer.roulette;
   // VPL connections: fresh light vertices before every pass, for tracers of this refinement only.
   const int joinPaths = settings_.connections.pathsFor(w * h, request.mode);
-  LightVertexCache joins;
+  if (joinPaths > 0 && !mine.joins) mine.joins = std::make_unique<LightVertexCache>(settings_.connections.learnChoice);
   std::optional<PathTracer> joinTracer, joinWindowTracer;
   auto refineTracer = [&]() -> const PathTracer& {
     const bool windowed = rule == RouletteRule::Vpl || (rule == RouletteRule::Auto && mine.window.on());
@@ -329,7 +330,7 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
     }
     if (joinPaths <= 0) return windowed ? *windowTracer_ : tracer_;
     std::optional<PathTracer>& t = windowed ? joinWindowTracer : joinTracer;
-    if (!t) t.emplace(scene, windowed ? windowTracer_->settings() : settings_.tracer, windowed ? irradiance_.get() : nullptr, &joins);
+    if (!t) t.emplace(scene, windowed ? windowTracer_->settings() : settings_.tracer, windowed ? irradiance_.get() : nullptr, mine.joins.get());
     return *t;
   };
   std::optional<TileRenderer> renderer;
@@ -348,7 +349,7 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
   }
   while (mine.complete < settings_.maxSpp) {
     const auto t = Clock::now();
-    if (joinPaths > 0) joins.build(scene, settings_.seed, mine.nextPass, joinPaths, settings_.tracer.maxDepth - 1);
+    if (joinPaths > 0) mine.joins->build(scene, settings_.seed, mine.nextPass, joinPaths, settings_.tracer.maxDepth - 1);
     const PassStats pass = renderer->renderPass(*mine.film, mine.nextPass++, &cancel_);
     state.renderSeconds += secondsSince(t);
     state.samples += pass.samples;

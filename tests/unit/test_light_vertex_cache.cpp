@@ -1,0 +1,121 @@
+// The light vertex cache's choice of the vertex a camera vertex joins: the probability that each pick
+// reports (through its scale) is the one it is drawn with, before and after learning. That the joins
+// stay unbiased on whole scenes is WhiteFurnace.ConvergesWithVplConnections and the guided modes'
+// agreement with brdf (test_guided_modes), which join by the learned choice.
+#include <map>
+#include <vector>
+#include "render/integrator/light_vertex_cache.h"
+#include "render/sampling/rng.h"
+#include "render/scene/gltf_loader.h"
+#include "tests/unit/support.h"
+
+namespace vpl {
+namespace {
+
+constexpr int kPaths = 256;
+
+// Each vertex's pick probability as its scale states it: scale = 1 / (probability x paths).
+std::vector<double> statedProbabilities(const LightVertexCache& cache) {
+  std::vector<double> p(cache.vertices().size(), 0.0);
+  const size_t n = p.size();
+  // Every vertex is reached by some u: sweep u finely enough to land in each one.
+  for (size_t i = 0; i < 64 * n; ++i) {
+    float scale = 0.0f;
+    const LightVertex& v = cache.pick((float(i) + 0.5f) / float(64 * n), scale);
+    p[size_t(&v - cache.vertices().data())] = 1.0 / (double(scale) * kPaths);
+  }
+  return p;
+}
+
+// Draws picks with random numbers and compares the histogram of vertices with the stated
+// probabilities (chi-square; vertices expected fewer than 5 times pooled).
+double pickChiSquarePValue(const LightVertexCache& cache, const std::vector<double>& stated, int draws) {
+  std::vector<double> counts(stated.size(), 0.0);
+  Rng rng(7);
+  for (int i = 0; i < draws; ++i) {
+    float scale = 0.0f;
+    ++counts[size_t(&cache.pick(rng.uniform(), scale) - cache.vertices().data())];
+  }
+  double statistic = 0.0, pooledExpected = 0.0, pooledCount = 0.0;
+  int bins = 0;
+  for (size_t i = 0; i < stated.size(); ++i) {
+    const double expected = stated[i] * draws;
+    if (expected < 5.0) {
+      pooledExpected += expected;
+      pooledCount += counts[i];
+      continue;
+    }
+    statistic += (counts[i] - expected) * (counts[i] - expected) / expected;
+    ++bins;
+  }
+  if (pooledExpected >= 5.0) {
+    statistic += (pooledCount - pooledExpected) * (pooledCount - pooledExpected) / pooledExpected;
+    ++bins;
+  }
+  return test::chiSquareTail(statistic, bins - 1);
+}
+
+RenderScene cornellBox() { return RenderScene(loadGltf(test::sourceDir() + "/scenes/cornell_box.gltf")); }
+
+TEST(LightVertexCache, UniformChoiceGivesEveryVertexTheSameProbability) {
+  const RenderScene scene = cornellBox();
+  LightVertexCache cache(false);
+  cache.build(scene, 1, 0, kPaths, 8);
+  ASSERT_FALSE(cache.empty());
+  for (size_t i = 0; i < cache.vertices().size(); ++i) cache.record(cache.vertices()[i], 5.0f);  // ignored
+  cache.build(scene, 1, 1, kPaths, 8);
+  EXPECT_EQ(cache.learnedShare(), 0.0f);
+  const std::vector<double> p = statedProbabilities(cache);
+  for (const double pi : p) EXPECT_NEAR(pi * double(p.size()), 1.0, 1e-4);
+  EXPECT_GT(pickChiSquarePValue(cache, p, 200000), 1e-3);
+}
+
+// After a pass whose joins brought light back from a few cells only, those cells are picked more
+// often, every other vertex keeps at least the uniform share, and each pick's scale is exact.
+TEST(LightVertexCache, LearnedChoiceDrawsEachVertexWithTheProbabilityItsScaleStates) {
+  const RenderScene scene = cornellBox();
+  LightVertexCache cache;
+  cache.build(scene, 1, 0, kPaths, 8);
+  ASSERT_FALSE(cache.empty());
+  EXPECT_EQ(cache.learnedShare(), 0.0f);  // nothing learned yet: uniform
+  std::map<uint32_t, int> cellsSeen;
+  for (const LightVertex& v : cache.vertices()) ++cellsSeen[v.cell];
+  ASSERT_GT(cellsSeen.size(), 4u);
+  // Joins to the vertices of every third cell brought light back, the rest none.
+  for (const LightVertex& v : cache.vertices())
+    if (v.cell % 3 == 0) cache.record(v, 0.25f);
+  cache.build(scene, 1, 1, kPaths, 8);
+  EXPECT_FLOAT_EQ(cache.learnedShare(), 1.0f - LightVertexCache::kUniformShare);
+
+  const std::vector<double> p = statedProbabilities(cache);
+  double sum = 0.0, lit = 0.0, smallest = 1.0, largest = 0.0;
+  const double uniform = 1.0 / double(p.size());
+  for (size_t i = 0; i < p.size(); ++i) {
+    sum += p[i];
+    if (cache.vertices()[i].cell % 3 == 0) lit += p[i];
+    smallest = std::min(smallest, p[i]);
+    largest = std::max(largest, p[i]);
+  }
+  EXPECT_NEAR(sum, 1.0, 1e-4);
+  EXPECT_GE(smallest, LightVertexCache::kUniformShare * uniform * (1.0 - 1e-4));
+  EXPECT_GT(largest, 2.0 * uniform);  // the learned choice is not uniform
+  EXPECT_GT(lit, 1.0 - LightVertexCache::kUniformShare);
+  EXPECT_GT(pickChiSquarePValue(cache, p, 400000), 1e-3);
+}
+
+// What is recorded is summed as integers: the same records in another order give the same choice.
+TEST(LightVertexCache, RecordsInAnyOrderGiveTheSameChoice) {
+  const RenderScene scene = cornellBox();
+  LightVertexCache forward, backward;
+  forward.build(scene, 3, 0, kPaths, 8);
+  backward.build(scene, 3, 0, kPaths, 8);
+  const std::vector<LightVertex>& v = forward.vertices();
+  for (size_t i = 0; i < v.size(); ++i) forward.record(v[i], 0.1f + 0.37f * float(i % 7));
+  for (size_t i = v.size(); i-- > 0;) backward.record(backward.vertices()[i], 0.1f + 0.37f * float(i % 7));
+  forward.build(scene, 3, 1, kPaths, 8);
+  backward.build(scene, 3, 1, kPaths, 8);
+  EXPECT_EQ(statedProbabilities(forward), statedProbabilities(backward));
+}
+
+}  // namespace
+}  // namespace vpl
