@@ -28,7 +28,8 @@ struct PathVertices {
   uint64_t rays = 0;
 };
 
-void traceLightSubpath(const RenderScene& scene, uint64_t key, int maxLength, PathVertices& out) {
+void traceLightSubpath(const RenderScene& scene, const LightVertexCache& cache, uint64_t key, int maxLength,
+                       PathVertices& out) {
   Rng rng = Rng::hashed(key);
   const auto e = startLightPath(scene, rng);
   if (!e) return;
@@ -51,17 +52,34 @@ void traceLightSubpath(const RenderScene& scene, uint64_t key, int maxLength, Pa
   // Roulette is not counted in the MIS weights: they sum to 1 whatever it does.
   const auto onScatter = [&](const LightWalkVertex& v, const BsdfSample& s, float cosOut) {
     dVC = connectionMis(cosOut / s.pdf) * (dVC * connectionMis(v.bsdf.pdf(s.wi, v.wIn)) + dVCM);
-    dVCM = connectionMis(1.0f / s.pdf);
+    dVCM = connectionMis(1.0f / s.pdf) * cache.misFactor(v.surface.position);  // a join with its light end here
   };
   out.rays += walkLightPath(scene, rng, *e, maxLength, onVertex, onScatter);
 }
 
 }  // namespace
 
-void LightVertexCache::build(const RenderScene& scene, uint64_t seed, uint64_t pass, int paths, int maxLength) {
+void LightVertexCache::learnFromLastPass() {
   // What the joins of the last pass brought back joins the sums of the passes before it.
-  for (int k = 0; k < kCells; ++k)
-    learned_[size_t(k)] += double(pending_[size_t(k)].exchange(0, std::memory_order_relaxed)) / double(kFixedPoint);
+  double learnedTotal = 0.0, seenTotal = 0.0;
+  for (size_t k = 0; k < size_t(kCells); ++k) {
+    learned_[k] += double(pending_[k].exchange(0, std::memory_order_relaxed)) / double(kFixedPoint);
+    learnedTotal += learned_[k];
+    seenTotal += seen_[k];
+  }
+  // A cell's expected pick rate over uniform choice's: its learned share over its share of the
+  // vertices, mixed as chooseCells mixes them.
+  const double learned = learnChoice_ && learnedTotal > 0.0 ? 1.0 - double(kUniformShare) : 0.0;
+  for (size_t k = 0; k < size_t(kCells); ++k) {
+    const double rate = seen_[k] > 0.0 ? (learned_[k] / learnedTotal) / (seen_[k] / seenTotal) : 0.0;
+    misFactor_[k] = connectionMis(float((1.0 - learned) + (learned > 0.0 ? learned * rate : 0.0)));
+  }
+}
+
+void LightVertexCache::build(const RenderScene& scene, uint64_t seed, uint64_t pass, int paths, int maxLength) {
+  low_ = scene.data().boundsMin;
+  perUnit_ = float(kCellsPerAxis) / glm::max(scene.data().boundsMax - low_, glm::vec3(1e-20f));
+  learnFromLastPass();
   vertices_.clear();
   cellOf_.clear();
   cellStart_.clear();
@@ -79,7 +97,7 @@ void LightVertexCache::build(const RenderScene& scene, uint64_t seed, uint64_t p
   // Batches in parallel, appended in path order: the cache is the same for any thread count.
   tbb::parallel_for(0, batches, [&](int b) {
     const int end = std::min(paths, (b + 1) * kBatch);
-    for (int i = b * kBatch; i < end; ++i) traceLightSubpath(scene, mix64(passKey ^ uint64_t(i)), maxLength, results[size_t(b)]);
+    for (int i = b * kBatch; i < end; ++i) traceLightSubpath(scene, *this, mix64(passKey ^ uint64_t(i)), maxLength, results[size_t(b)]);
   });
   std::vector<LightVertex> traced;
   size_t total = 0;
@@ -90,20 +108,17 @@ void LightVertexCache::build(const RenderScene& scene, uint64_t seed, uint64_t p
     rays_ += r.rays;
   }
   if (traced.empty()) return;
-  sortIntoCells(scene, std::move(traced));
+  sortIntoCells(std::move(traced));
   chooseCells(paths);
 }
 
-void LightVertexCache::sortIntoCells(const RenderScene& scene, std::vector<LightVertex>&& traced) {
-  const glm::vec3 low = scene.data().boundsMin;
-  const glm::vec3 perUnit = float(kCellsPerAxis) / glm::max(scene.data().boundsMax - low, glm::vec3(1e-20f));
+void LightVertexCache::sortIntoCells(std::vector<LightVertex>&& traced) {
   std::vector<uint32_t> count(kCells, 0);
   for (LightVertex& v : traced) {
-    const glm::ivec3 c = glm::clamp(glm::ivec3(glm::clamp((v.position - low) * perUnit, 0.0f, float(kCellsPerAxis))),
-                                    glm::ivec3(0), glm::ivec3(kCellsPerAxis - 1));
-    v.cell = uint32_t((c.z * kCellsPerAxis + c.y) * kCellsPerAxis + c.x);
+    v.cell = cellOf(v.position);
     ++count[v.cell];
   }
+  for (size_t k = 0; k < size_t(kCells); ++k) seen_[k] += double(count[k]);
   // A counting sort, stable: the order within a cell stays the path order.
   std::vector<uint32_t> next(kCells, 0);
   for (uint32_t k = 0, start = 0; k < uint32_t(kCells); start += count[k++]) {

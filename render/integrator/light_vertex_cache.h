@@ -15,8 +15,10 @@
 // contribution: the join's value over its pick probability), mixed with the uniform choice
 // (kUniformShare, so that no vertex's probability falls below that share of uniform's), then a
 // vertex of the cell uniformly. The join divides by the probability it was actually picked with.
-// The MIS weights keep uniform choice's densities: weights only need to sum to 1 over the ways of
-// making a path, and they still do, so the estimate stays unbiased; they are merely not re-tuned.
+// The MIS weights count a join to a vertex of cell k as m_k joins of uniform choice, m_k being the
+// cell's expected pick rate over uniform's from the earlier passes (misFactor): fixed during a
+// pass and known on both sides, it is the same for every way of making a path, so the weights
+// still sum to 1 (and the estimate stays unbiased) even where this pass's actual rate differs.
 //
 // Parameters:
 //   paths     per pass (ConnectionSettings::paths): more paths, less correlation between pixels of
@@ -99,6 +101,9 @@ class LightVertexCache {
     const float clamped = std::min(contribution, kLargestRecord);  // a rare spike must not overflow the sum
     pending_[y.cell].fetch_add(uint64_t(clamped * kFixedPoint), std::memory_order_relaxed);
   }
+  // connectionMis of the MIS count of a join whose light end is at p (in cell y.cell): see above.
+  float misFactor(const glm::vec3& p) const { return misFactor_[cellOf(p)]; }
+  float misFactor(const LightVertex& y) const { return misFactor_[y.cell]; }
   uint64_t rays() const { return rays_; }
   // The share of picks that go to the cells' learned choice rather than the uniform one (0 before
   // anything is learned or without learning).
@@ -109,7 +114,13 @@ class LightVertexCache {
   static constexpr float kFixedPoint = 1048576.0f;  // 2^20: records are summed as integers
   static constexpr float kLargestRecord = 1024.0f;
 
-  void sortIntoCells(const RenderScene& scene, std::vector<LightVertex>&& traced);
+  uint32_t cellOf(const glm::vec3& p) const {
+    const glm::ivec3 c = glm::clamp(glm::ivec3(glm::clamp((p - low_) * perUnit_, 0.0f, float(kCellsPerAxis))),
+                                    glm::ivec3(0), glm::ivec3(kCellsPerAxis - 1));
+    return uint32_t((c.z * kCellsPerAxis + c.y) * kCellsPerAxis + c.x);
+  }
+  void learnFromLastPass();
+  void sortIntoCells(std::vector<LightVertex>&& traced);
   void chooseCells(int paths);
 
   bool learnChoice_;
@@ -117,7 +128,10 @@ class LightVertexCache {
   // The non-empty cells: their first vertex, vertex count, pick probabilities (cumulative) and scale.
   std::vector<uint32_t> cellOf_, cellStart_, cellCount_;
   std::vector<float> cellCdf_, cellScale_;
+  glm::vec3 low_{0.0f}, perUnit_{0.0f};  // the scene's box: cell coordinates
   std::vector<double> learned_ = std::vector<double>(kCells, 0.0);  // every pass so far, per cell
+  std::vector<double> seen_ = std::vector<double>(kCells, 0.0);     // vertices, every pass so far, per cell
+  std::vector<float> misFactor_ = std::vector<float>(kCells, 1.0f);
   mutable std::vector<std::atomic<uint64_t>> pending_ = std::vector<std::atomic<uint64_t>>(kCells);  // this pass
   float learnedShare_ = 0.0f;
   uint64_t rays_ = 0;

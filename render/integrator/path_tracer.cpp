@@ -138,7 +138,8 @@ glm::vec3 PathTracer::connect(const SurfaceHit& surface, const Bsdf& bsdf, const
   const float wLight = connectionMis(cameraPdf * cosLight / dist2) * (y.dVCM + y.dVC * connectionMis(light.pdf));
   const float cameraSide = path.dVCM + (path.dVC > 0.0f ? path.dVC * connectionMis(bsdf.pdf(w, wo)) : 0.0f);
   const float wCamera = cameraSide > 0.0f ? connectionMis(y.bsdf.pdf(y.wIn, -w) * cosCamera / dist2) * cameraSide : 0.0f;
-  const float weight = bidirectionalWeight(wLight + wCamera);
+  // Over this join's own count (the other joins' counts are in the partial sums).
+  const float weight = bidirectionalWeight((wLight + wCamera) / connections_->misFactor(y));
   if (!(weight > 0.0f)) return glm::vec3(0.0f);
   ++stats.rays;
   if (scene_.accel().occluded(spawnShadowRay(surface, w, dist))) return glm::vec3(0.0f);
@@ -192,6 +193,9 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
       if (!isBlack(le)) {
         L += beta * le * emitterHitWeight(surface, wo, path);
       }
+      // From here on dVCM stands for a join with its light end at this vertex (for the emitter hit
+      // above, next-event estimation's sample of it), which counts as the cache's factor of joins.
+      if (connections_) path.dVCM *= connections_->misFactor(surface.position);
       if (depth + 1 > settings_.maxDepth) break;
 
       const Bsdf bsdf = scene_.bsdf(surface, wo);

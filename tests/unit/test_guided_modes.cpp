@@ -175,19 +175,24 @@ TEST(PixelAgreement, SeesABiasInSomePixelsOrOneThatCancelsOut) {
 
 // A consistency check, not a bias check (the per-pixel tests above are): the spread between two seeds
 // falls as 1/spp. Chains shared by the pixels of a tile correlate their errors, so allow some slack
-// below the ideal ratio of 8.
+// below the ideal ratio of 8. With the joins' learned choice of light vertices the later passes are
+// better than the first ones, so the spread may fall faster (measured: uniform 7.0-9.6, learned
+// 6.8-12.6), up to 20.
 TEST(GuidedModes, SpreadBetweenSeedsFallsAsOneOverSpp) {
   const SceneData data = loadGltf(scenePath("two_rooms.gltf"));
-  for (SamplingMode mode : {SamplingMode::Mis, SamplingMode::Metropolis, SamplingMode::Mixture}) {
-    auto spread = [&](int spp) {
-      return relMse(runRenderJob(settings("two_rooms.gltf", mode, spp, 11), data).image,
-                    runRenderJob(settings("two_rooms.gltf", mode, spp, 12), data).image);
-    };
-    const double e16 = spread(16), e128 = spread(128);
-    std::printf("%s relMSE between seeds: 16 spp %.4g, 128 spp %.4g (ratio %.2f, ideal 8)\n", modeName(mode), e16, e128,
-                e16 / e128);
-    EXPECT_GT(e16 / e128, 4.0) << modeName(mode);
-    EXPECT_LT(e16 / e128, 12.0) << modeName(mode);
+  for (const bool learnChoice : {false, true}) {
+    for (SamplingMode mode : {SamplingMode::Mis, SamplingMode::Metropolis, SamplingMode::Mixture}) {
+      auto spread = [&](int spp) {
+        RenderJobSettings a = settings("two_rooms.gltf", mode, spp, 11), b = settings("two_rooms.gltf", mode, spp, 12);
+        a.connections.learnChoice = b.connections.learnChoice = learnChoice;
+        return relMse(runRenderJob(a, data).image, runRenderJob(b, data).image);
+      };
+      const double e16 = spread(16), e128 = spread(128);
+      std::printf("%s, %s joins: relMSE between seeds: 16 spp %.4g, 128 spp %.4g (ratio %.2f, ideal 8)\n", modeName(mode),
+                  learnChoice ? "learned" : "uniform", e16, e128, e16 / e128);
+      EXPECT_GT(e16 / e128, 4.0) << modeName(mode);
+      EXPECT_LT(e16 / e128, learnChoice ? 20.0 : 12.0) << modeName(mode);
+    }
   }
 }
 
