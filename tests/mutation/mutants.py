@@ -69,6 +69,14 @@ MUTANTS = [
      "if (path.depth + 1 + y.length > settings_.maxDepth) return glm::vec3(0.0f);",
      "if (path.depth + 1 + y.length > settings_.maxDepth + 1) return glm::vec3(0.0f);",
      "VPL connections make paths one segment longer than --max-depth"),
+    ("join-scale-of-uniform-choice", "render/integrator/light_vertex_cache.cpp",
+     "cellScale_.push_back(width > 0.0 ? float(double(cellCount_[c]) / (width * double(paths))) : 0.0f);",
+     "cellScale_.push_back(float(count / double(paths)));",
+     "learned joins divide by uniform choice's probability, not the one they were picked with"),
+    ("join-mis-count-only-on-light-side", "render/integrator/path_tracer.cpp",
+     "      if (connections_) path.dVCM *= connections_->misFactor(surface.position);",
+     "",
+     "the camera side's MIS sums leave out the joins' counts that the light side and the join put in"),
 ]
 
 
