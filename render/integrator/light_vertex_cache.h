@@ -113,6 +113,9 @@ class LightVertexCache {
   static constexpr int kCells = kCellsPerAxis * kCellsPerAxis * kCellsPerAxis;
   static constexpr float kFixedPoint = 1048576.0f;  // 2^20: records are summed as integers
   static constexpr float kLargestRecord = 1024.0f;
+  // A bound on a join's MIS count: the partial sums multiply counts along a path, and a sum that
+  // overflows zeroes the weight. Any bound keeps the weights summing to 1.
+  static constexpr float kLargestMisCount = 100.0f;
 
   uint32_t cellOf(const glm::vec3& p) const {
     const glm::ivec3 c = glm::clamp(glm::ivec3(glm::clamp((p - low_) * perUnit_, 0.0f, float(kCellsPerAxis))),
