@@ -71,8 +71,8 @@ void LightVertexCache::learnFromLastPass() {
   // vertices, mixed as chooseCells mixes them.
   const double learned = learnChoice_ && learnedTotal > 0.0 ? 1.0 - double(kUniformShare) : 0.0;
   for (size_t k = 0; k < size_t(kCells); ++k) {
-    const double rate = seen_[k] > 0.0 ? (learned_[k] / learnedTotal) / (seen_[k] / seenTotal) : 0.0;
-    const double count = (1.0 - learned) + (learned > 0.0 ? learned * rate : 0.0);
+    const double rate = learned > 0.0 && seen_[k] > 0.0 ? (learned_[k] / learnedTotal) / (seen_[k] / seenTotal) : 0.0;
+    const double count = (1.0 - learned) + learned * rate;
     misFactor_[k] = connectionMis(float(std::min(count, double(kLargestMisCount))));
   }
 }
