@@ -69,7 +69,7 @@ void LightVertexCache::learnFromLastPass() {
   }
   // A cell's expected pick rate over uniform choice's: its learned share over its share of the
   // vertices, mixed as chooseCells mixes them.
-  const double learned = learnChoice_ && learnedTotal > 0.0 ? 1.0 - double(kUniformShare) : 0.0;
+  const double learned = learnedShareFor(learnedTotal);
   for (size_t k = 0; k < size_t(kCells); ++k) {
     const double rate = learned > 0.0 && seen_[k] > 0.0 ? (learned_[k] / learnedTotal) / (seen_[k] / seenTotal) : 0.0;
     const double count = (1.0 - learned) + learned * rate;
@@ -100,27 +100,29 @@ void LightVertexCache::build(const RenderScene& scene, uint64_t seed, uint64_t p
     const int end = std::min(paths, (b + 1) * kBatch);
     for (int i = b * kBatch; i < end; ++i) traceLightSubpath(scene, *this, mix64(passKey ^ uint64_t(i)), maxLength, results[size_t(b)]);
   });
-  std::vector<LightVertex> traced;
-  size_t total = 0;
-  for (const PathVertices& r : results) total += r.vertices.size();
-  traced.reserve(total);
+  std::vector<std::vector<LightVertex>> batchVertices;
+  batchVertices.reserve(results.size());
   for (PathVertices& r : results) {
-    traced.insert(traced.end(), r.vertices.begin(), r.vertices.end());
+    batchVertices.push_back(std::move(r.vertices));
     rays_ += r.rays;
   }
-  if (traced.empty()) return;
-  sortIntoCells(std::move(traced));
+  sortIntoCells(batchVertices);
+  if (vertices_.empty()) return;
   chooseCells(paths);
 }
 
-void LightVertexCache::sortIntoCells(std::vector<LightVertex>&& traced) {
+void LightVertexCache::sortIntoCells(std::vector<std::vector<LightVertex>>& batches) {
   std::vector<uint32_t> count(kCells, 0);
-  for (LightVertex& v : traced) {
-    v.cell = cellOf(v.position);
-    ++count[v.cell];
+  size_t total = 0;
+  for (std::vector<LightVertex>& batch : batches) {
+    total += batch.size();
+    for (LightVertex& v : batch) {
+      v.cell = cellOf(v.position);
+      ++count[v.cell];
+    }
   }
   for (size_t k = 0; k < size_t(kCells); ++k) seen_[k] += double(count[k]);
-  // A counting sort, stable: the order within a cell stays the path order.
+  // A counting sort of the batches straight into vertices_, stable: within a cell, path order.
   std::vector<uint32_t> next(kCells, 0);
   for (uint32_t k = 0, start = 0; k < uint32_t(kCells); start += count[k++]) {
     next[k] = start;
@@ -129,14 +131,15 @@ void LightVertexCache::sortIntoCells(std::vector<LightVertex>&& traced) {
     cellStart_.push_back(start);
     cellCount_.push_back(count[k]);
   }
-  vertices_.resize(traced.size());
-  for (LightVertex& v : traced) vertices_[next[v.cell]++] = std::move(v);
+  vertices_.resize(total);
+  for (std::vector<LightVertex>& batch : batches)
+    for (LightVertex& v : batch) vertices_[next[v.cell]++] = std::move(v);
 }
 
 void LightVertexCache::chooseCells(int paths) {
   double learnedTotal = 0.0;
   for (const uint32_t k : cellOf_) learnedTotal += learned_[k];
-  const double learned = learnChoice_ && learnedTotal > 0.0 ? 1.0 - double(kUniformShare) : 0.0;
+  const double learned = learnedShareFor(learnedTotal);
   learnedShare_ = float(learned);
   const double count = double(vertices_.size());
   double cumulative = 0.0;

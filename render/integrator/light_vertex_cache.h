@@ -122,8 +122,13 @@ class LightVertexCache {
                                     glm::ivec3(0), glm::ivec3(kCellsPerAxis - 1));
     return uint32_t((c.z * kCellsPerAxis + c.y) * kCellsPerAxis + c.x);
   }
+  // The share of picks that follow what was learned, given the learned sum over the cells considered.
+  double learnedShareFor(double learnedTotal) const {
+    return learnChoice_ && learnedTotal > 0.0 ? 1.0 - double(kUniformShare) : 0.0;
+  }
   void learnFromLastPass();
-  void sortIntoCells(std::vector<LightVertex>&& traced);
+  // Sorts the light paths' vertices (in path order, batch by batch) into vertices_ by cell.
+  void sortIntoCells(std::vector<std::vector<LightVertex>>& batches);
   void chooseCells(int paths);
 
   bool learnChoice_;
