@@ -68,6 +68,12 @@ nlohmann::ordered_json summaryJson(const RenderJobSettings& s, const RenderJobRe
   if (s.mode == SamplingMode::Metropolis || s.mode == SamplingMode::Mis || s.mode == SamplingMode::Mixture) {
     j["acceptance"] = r.proposals > 0 ? double(r.accepted) / double(r.proposals) : 0.0;
     j["guide_bytes"] = r.guideBytes;
+    j["guide_learning"] = s.guide.learnDirections;
+    if (s.guide.learnDirections) {
+      j["guide_prior"] = s.guide.vplPrior ? "vpl" : "none";
+      j["guide_learned_share"] = r.learnedGuideShare;
+      j["guide_learning_s"] = r.timings.guideLearning;
+    }
   }
   if (s.mode == SamplingMode::Mis) {  // learned: the mean over cache points with enough samples (null: none yet)
     if (!s.guide.learnSelection) j["bsdf_prob"] = s.guide.bsdfProbability;

@@ -121,6 +121,15 @@ void RenderOptions::addCommonTo(CLI::App& command) {
         }
         return "--bsdf-prob must be auto or a number in [0, 1], not '" + v + "'";
       });
+  command.add_option_function<std::string>(
+            "--guide-learning", [this](const std::string& v) { guide.learnDirections = v == "on"; },
+            "guided modes: on: each cache point's guide learns from what the paths bring back between passes, "
+            "starting from the VPLs' | off: the VPL guide alone (Hua & Low)")
+      ->check(CLI::IsMember({"on", "off"}));
+  command.add_option_function<std::string>(
+            "--guide-prior", [this](const std::string& v) { guide.vplPrior = v == "vpl"; },
+            "--guide-learning on: what the guide starts from: vpl | none (uniform: learned only)")
+      ->check(CLI::IsMember({"vpl", "none"}));
   command.add_option("--mis-guide", misGuide,
                      "mis: where guide directions come from: exact (samples of the guide from the BSDF's stratified "
                      "number) | chain (the cache point's Metropolis chain, as the paper)")

@@ -104,6 +104,11 @@ GuideDistribution::GuideDistribution(const std::vector<GuideRepresentative>& rep
   cellDensity_ = float((1.0 - defensive_) / kCellSolidAngle);
 }
 
+GuideDistribution::GuideDistribution(std::span<const float> cellWeights, float defensive)
+    : choice_(cellWeights), total_(choice_.total()), defensive_(defensive) {
+  cellDensity_ = float((1.0 - defensive_) / kCellSolidAngle);
+}
+
 float GuideDistribution::pdf(const glm::vec3& w) const {
   if (choice_.empty()) return uniformSpherePdf();
   return cellDensity_ * choice_.pmf(size_t(cellOf(w))) + defensive_ * uniformSpherePdf();

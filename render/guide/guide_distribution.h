@@ -10,6 +10,7 @@
 // costs one table read; sampling picks a cell by its mass, then a uniform point in it.
 #pragma once
 #include <cstdint>
+#include <span>
 #include <vector>
 #include <glm/glm.hpp>
 #include "render/sampling/distribution_1d.h"
@@ -33,6 +34,8 @@ class GuideDistribution {
 
   GuideDistribution() = default;
   GuideDistribution(const std::vector<GuideRepresentative>& representatives, float coneAngle, float defensive);
+  // A table given cell by cell (kCells weights >= 0), as the learner blends it; Z is their sum.
+  GuideDistribution(std::span<const float> cellWeights, float defensive);
 
   // f(w): weight per steradian of w's cell.
   float target(const glm::vec3& w) const { return float(choice_.pmf(size_t(cellOf(w))) * total_ / kCellSolidAngle); }
@@ -50,6 +53,9 @@ class GuideDistribution {
   }
 
   double totalWeight() const { return total_; }
+  // The table's share of cell c (0 everywhere for a uniform guide, Z = 0).
+  float cellShare(int c) const { return choice_.pmf(size_t(c)); }
+  bool uniform() const { return choice_.empty(); }
   size_t size() const { return representativeCount_; }
   float defensive() const { return defensive_; }
 

@@ -12,6 +12,10 @@
 //   learnSelection     bool   false  mis: each cache point learns its probability from the paths between passes
 //                                    (selection_learner.h). Measured at 10 s (2 seeds): 1.04-1.08x the relMSE of a
 //                                    fixed 0.5 on the Cornell box, 0.99-1.02x on two_rooms; off by default
+//   learnDirections    bool   false  each cache point's guide learns from what the paths bring back between passes,
+//                                    with the VPL guide as its prior (guide_learner.h; --guide-learning on)
+//   vplPrior           bool   true   learnDirections: start from the VPL guide; false: from a uniform one (a
+//                                    learned-only baseline, --guide-prior none)
 //   misChain           bool   false  mis: guide directions from the cache point's Markov chain (the paper); false:
 //                                    exact samples of the guide from the BSDF's own stratified number
 //   lookupCosNormal    float  0.9    a vertex uses a cache point only if their normals agree this well
@@ -37,6 +41,8 @@ struct GuideSettings {
   int mutations = 1;
   float bsdfProbability = 0.5f;
   bool learnSelection = false;
+  bool learnDirections = false;
+  bool vplPrior = true;
   bool misChain = false;
   float lookupCosNormal = 0.9f;
   float lookupRadiusScale = 1.5f;

@@ -57,11 +57,11 @@ bool GuidedContinuation::sample(const SurfaceHit& hit, const Bsdf& bsdf, const g
     if (pBsdf >= 1.0f) {  // an unguided vertex: the sample's own pdf and weight are the strategy's
       out.pdf = s->pdf;
       out.weight = s->weight;
-      if (learnsAt(c)) noteFirstVertex(c, {s->pdf, field_.point(c).distribution.pdf(out.wi), s->pdf});
+      if (learnsAt(c)) noteFirstVertex(c, out.wi, {s->pdf, guideAt(c).pdf(out.wi), s->pdf});
       return true;
     }
   } else {
-    const GuideDistribution& guide = field_.point(c).distribution;
+    const GuideDistribution& guide = guideAt(c);
     const bool revisit = std::find(chainsUsedByPath_.begin(), chainsUsedByPath_.end(), c) != chainsUsedByPath_.end();
     if (shared) {
       out.wi = guide.sample(glm::vec2(std::min((uBsdf.x - pBsdf) / (1.0f - pBsdf), 0x1.fffffep-1f), uBsdf.y));
@@ -81,7 +81,7 @@ bool GuidedContinuation::sample(const SurfaceHit& hit, const Bsdf& bsdf, const g
     ++stats.guideSamples;
   }
   const Densities d = densities(c, bsdf, wo, out.wi);
-  if (learnsAt(c)) noteFirstVertex(c, d);
+  if (learnsAt(c)) noteFirstVertex(c, out.wi, d);
   out.pdf = d.mixture;
   return out.pdf > 0.0f;
 }
@@ -91,7 +91,7 @@ GuidedContinuation::Densities GuidedContinuation::densities(int c, const Bsdf& b
   const float pBsdf = bsdfProbability(c);
   Densities d;
   d.bsdf = pBsdf > 0.0f ? bsdf.pdf(wo, wi) : 0.0f;
-  d.guide = pBsdf < 1.0f ? field_.point(c).distribution.pdf(wi) : 0.0f;
+  d.guide = pBsdf < 1.0f ? guideAt(c).pdf(wi) : 0.0f;
   d.mixture = pBsdf >= 1.0f ? d.bsdf : pBsdf > 0.0f ? pBsdf * d.bsdf + (1.0f - pBsdf) * d.guide : d.guide;
   return d;
 }
@@ -104,7 +104,9 @@ float GuidedContinuation::pdf(const SurfaceHit& hit, const Bsdf& bsdf, const glm
 void GuidedContinuation::endPath(const glm::vec3& firstContinuation) {
   if (first_.cachePoint < 0) return;
   const Densities& d = first_.densities;
-  log_->add(first_.cachePoint, d.bsdf, d.guide, d.mixture, std::max(0.0f, luminance(firstContinuation)));
+  const float value = std::max(0.0f, luminance(firstContinuation));
+  if (log_) log_->add(first_.cachePoint, d.bsdf, d.guide, d.mixture, value);
+  if (guideLog_) guideLog_->add(first_.cachePoint, first_.wi, value);
   first_.cachePoint = -1;
 }
 

@@ -4,14 +4,15 @@
 //   mis         one-sample MIS of the BSDF and the Markov chain, balance heuristic with both pdfs
 // A vertex with no cache point nearby (distance or normal test), or with a near-specular BSDF,
 // samples its BSDF. mis's BSDF probability is the settings' own, or with a SelectionLearner each
-// cache point's learned one; the first vertex of every path then reports to the tile's log. One
-// object per tile and pass: its chains restart from exact samples, so results do not depend on
+// cache point's learned one; the guide is the VPLs', or with a GuideLearner the one learned from the
+// film's earlier passes. The first vertex of every path reports to the tile's logs of the learners.
+// One object per tile and pass: its chains restart from exact samples, so results do not depend on
 // scheduling.
 #pragma once
 #include <unordered_map>
 #include "render/guide/guide_field.h"
 #include "render/guide/metropolis_sampler.h"
-#include "render/guide/selection_learner.h"
+#include "render/guide/guide_learner.h"
 #include "render/integrator/path_tracer.h"
 #include "render/integrator/sampling_mode.h"
 
@@ -19,9 +20,10 @@ namespace vpl {
 
 class GuidedContinuation final : public ContinuationSampler {
  public:
-  GuidedContinuation(const GuideField& field, SamplingMode mode, const SelectionLearner* learner = nullptr,
-                     SelectionLearner::TileLog* log = nullptr)
-      : field_(field), mode_(mode), learner_(learner), log_(log) {}
+  GuidedContinuation(const GuideField& field, SamplingMode mode, GuideLearners learners = {}, uint32_t tile = 0)
+      : field_(field), mode_(mode), learner_(learners.selection),
+        log_(learners.selection ? &learners.selection->tileLog(tile) : nullptr), guides_(learners.directions),
+        guideLog_(learners.directions ? &learners.directions->tileLog(tile) : nullptr) {}
 
   bool sample(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, VertexSamples& u, DirectionSample& out,
               PathStats& stats) override;
@@ -45,10 +47,13 @@ class GuidedContinuation final : public ContinuationSampler {
     float bsdf = 0.0f, guide = 0.0f, mixture = 0.0f;
   };
   Densities densities(int c, const Bsdf& bsdf, const glm::vec3& wo, const glm::vec3& wi) const;
-  // Whether this vertex reports to the learner: the first of its path, served by cache point c.
-  bool learnsAt(int c) const { return log_ && vertex_ == 1 && c >= 0; }
-  // Keeps the first vertex's densities until endPath() knows what its continuation brought back.
-  void noteFirstVertex(int c, const Densities& d) { first_ = {c, d}; }
+  // The guide of cache point c for this pass.
+  const GuideDistribution& guideAt(int c) const { return guides_ ? guides_->distribution(c) : field_.point(c).distribution; }
+  // Whether this vertex reports to the learners: the first of its path, served by cache point c.
+  bool learnsAt(int c) const { return (log_ || guideLog_) && vertex_ == 1 && c >= 0; }
+  // Keeps the first vertex's direction and densities until endPath() knows what its continuation
+  // brought back.
+  void noteFirstVertex(int c, const glm::vec3& wi, const Densities& d) { first_ = {c, wi, d}; }
   // The cache point of a vertex; sample() and pdf() ask for the same vertex in a row, so remember it.
   int cachePoint(const SurfaceHit& hit);
   // The cache point that guides this vertex: none for a near-specular BSDF.
@@ -67,8 +72,11 @@ class GuidedContinuation final : public ContinuationSampler {
   int vertex_ = 0;              // the current vertex, from 1 (the camera ray's hit)
   const SelectionLearner* learner_;
   SelectionLearner::TileLog* log_;
+  const GuideLearner* guides_;
+  GuideLearner::TileLog* guideLog_;
   struct {
     int cachePoint = -1;
+    glm::vec3 wi{0.0f};
     Densities densities;
   } first_;
 };

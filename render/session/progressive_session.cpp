@@ -60,6 +60,7 @@ struct ProgressiveSession::CameraState {
     int complete = 0;
     WindowSwitch window;  // the auto roulette rule's decision for this film
     std::unique_ptr<SelectionLearner> learner;  // mis: each cache point's BSDF probability, from this film's passes
+    std::unique_ptr<GuideLearner> guides;       // each cache point's guide, learned from this film's passes
     std::unique_ptr<LightVertexCache> joins;    // VPL connections: its choice of vertices learns from this film's passes
   };
   std::optional<Request> key;
@@ -313,7 +314,9 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
     const SamplingMode mode = request.mode;
     if (mode == SamplingMode::Mis && settings_.guide.learnSelection && !mine.learner)
       mine.learner = std::make_unique<SelectionLearner>(guide.size(), TileRenderer::tileCountFor(w, h), settings_.guide.bsdfProbability);
-    continuation = guidedContinuations(guide, mode, mine.learner.get());
+    if (settings_.guide.learnDirections && !mine.guides)
+      mine.guides = std::make_unique<GuideLearner>(guide, TileRenderer::tileCountFor(w, h), settings_.guide.vplPrior);
+    continuation = guidedContinuations(guide, mode, {mine.learner.get(), mine.guides.get()});
   }
   const RouletteRule rule = settings_.tracer.roulette;
   // VPL connections: fresh light vertices before every pass, for tracers of this refinement only.
@@ -367,6 +370,7 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
       std::lock_guard lock(mutex_);
       stats_.learnedBsdfProbability = mine.learner->meanLearnedProbability();
     }
+    if (mine.guides) mine.guides->update();
     if (rule == RouletteRule::Auto && !mine.window.on() && WindowSwitch::updateDue(uint64_t(mine.complete)) &&
         mine.window.update(*mine.film)) {
       renderer.reset();

@@ -112,6 +112,7 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
   VplField field;
   GuideField guide;
   std::optional<SelectionLearner> learner;  // mis: each cache point's BSDF probability, from the passes so far
+  std::optional<GuideLearner> guideLearner;  // each cache point's guide, from the passes so far
   std::function<PixelShaderFactory(const PathTracer&)> shaderFor;
   if (settings.mode != SamplingMode::Brdf) {
     const auto t = Clock::now();
@@ -140,7 +141,10 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
       const SamplingMode mode = settings.mode;
       if (mode == SamplingMode::Mis && settings.guide.learnSelection)
         learner.emplace(guide.size(), TileRenderer::tileCountFor(settings.width, settings.height), settings.guide.bsdfProbability);
-      const ContinuationFactory continuation = guidedContinuations(guide, mode, learner ? &*learner : nullptr);
+      if (settings.guide.learnDirections)
+        guideLearner.emplace(guide, TileRenderer::tileCountFor(settings.width, settings.height), settings.guide.vplPrior);
+      const ContinuationFactory continuation = guidedContinuations(
+          guide, mode, {learner ? &*learner : nullptr, guideLearner ? &*guideLearner : nullptr});
       shaderFor = [continuation](const PathTracer& t) { return pathTracerShader(t, continuation); };
     }
   } else {
@@ -181,6 +185,11 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
     ++result.spp;
     if (pass == 0) result.firstImageSeconds = secondsSince(loaded);
     if (learner) learner->update();
+    if (guideLearner) {
+      const auto t = Clock::now();
+      guideLearner->update();
+      result.timings.guideLearning += secondsSince(t);
+    }
     if (autoRoulette && !window.on() && WindowSwitch::updateDue(uint64_t(result.spp))) {
       if (window.update(film)) {
         result.windowFromPass = result.spp;
@@ -193,6 +202,7 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
   }
   watch.reset();
   if (learner) result.learnedBsdfProbability = learner->meanLearnedProbability();
+  if (guideLearner) result.learnedGuideShare = guideLearner->meanLearnedShare();
   result.timings.render = secondsSince(renderStart);
   result.seconds = secondsSince(loaded);
   result.image = film.resolve();

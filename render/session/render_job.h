@@ -38,6 +38,7 @@ struct PhaseTimings {
   // cluster's parts: gather points, slice tree, LightSlice (reduced matrix, global clusters, per-slice
   // refinement) and, in the guided modes, the guide
   double gather = 0, slices = 0, matrix = 0, globalClusters = 0, refine = 0, guide = 0;
+  double guideLearning = 0;  // the learned guides' updates between passes (part of render)
 };
 
 struct RenderJobResult {
@@ -54,6 +55,7 @@ struct RenderJobResult {
   uint64_t branches = 0;                 // extra paths grown by splitting (the vpl roulette rule)
   int windowFromPass = 0;                // the auto rule: the window's first pass (0: never used)
   double learnedBsdfProbability = -1.0;  // mis: the mean learned BSDF probability over cache points (-1: none)
+  double learnedGuideShare = -1.0;       // learned guides: the mean weight of what was learned against the VPLs
   size_t guideBytes = 0;
   std::vector<std::string> notices;
 };

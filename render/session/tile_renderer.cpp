@@ -17,9 +17,9 @@ PixelShaderFactory pathTracerShader(const PathTracer& tracer, ContinuationFactor
   };
 }
 
-ContinuationFactory guidedContinuations(const GuideField& guide, SamplingMode mode, SelectionLearner* learner) {
-  return [&guide, mode, learner](uint32_t tile, uint64_t) {
-    return std::make_unique<GuidedContinuation>(guide, mode, learner, learner ? &learner->tileLog(tile) : nullptr);
+ContinuationFactory guidedContinuations(const GuideField& guide, SamplingMode mode, const GuideLearners& learners) {
+  return [&guide, mode, learners](uint32_t tile, uint64_t) {
+    return std::make_unique<GuidedContinuation>(guide, mode, learners, tile);
   };
 }
 

@@ -15,7 +15,7 @@
 namespace vpl {
 
 class GuideField;
-class SelectionLearner;
+struct GuideLearners;
 
 struct PassStats {
   uint64_t rays = 0;
@@ -41,9 +41,9 @@ using PixelShaderFactory = std::function<PixelShader(uint32_t tileIndex, uint64_
 // The path tracer as a pixel shader, with a continuation strategy per tile (nullptr: BSDF sampling).
 using ContinuationFactory = std::function<std::unique_ptr<ContinuationSampler>(uint32_t tileIndex, uint64_t pass)>;
 PixelShaderFactory pathTracerShader(const PathTracer& tracer, ContinuationFactory continuation = nullptr);
-// The guided modes' continuations: one per tile and pass, each writing its tile's log of `learner`
-// (mis with a learned BSDF probability; nullptr: none).
-ContinuationFactory guidedContinuations(const GuideField& guide, SamplingMode mode, SelectionLearner* learner);
+// The guided modes' continuations: one per tile and pass, each writing its tile's logs of the
+// learners (a learned BSDF probability for mis, learned guides; either may be absent).
+ContinuationFactory guidedContinuations(const GuideField& guide, SamplingMode mode, const GuideLearners& learners);
 
 class TileRenderer {
  public:

@@ -77,6 +77,14 @@ MUTANTS = [
      "      if (connections_) path.dVCM *= connections_->misFactor(surface.position);",
      "",
      "the camera side's MIS sums leave out the joins' counts that the light side and the join put in"),
+    ("learned-guide-pdf-of-the-prior", "render/integrator/guided_continuation.cpp",
+     "  d.guide = pBsdf < 1.0f ? guideAt(c).pdf(wi) : 0.0f;",
+     "  d.guide = pBsdf < 1.0f ? field_.point(c).distribution.pdf(wi) : 0.0f;",
+     "directions drawn from the learned guide weighted by the VPL guide's pdf"),
+    ("learned-guide-records-in-the-wrong-cell", "render/guide/guide_learner.cpp",
+     "    const double learnedShare = sums[size_t(learnedCellOfFine(f))] / (learnedTotal * kFineCells);",
+     "    const double learnedShare = sums[size_t(learnedCellOfFine(GuideDistribution::kCells - 1 - f))] / (learnedTotal * kFineCells);",
+     "the learned guide puts what a direction brought back on the opposite side of the sphere"),
 ]
 
 

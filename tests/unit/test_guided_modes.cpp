@@ -46,7 +46,8 @@ RenderJobSettings settings(const std::string& scene, SamplingMode mode, int spp,
 // `batches` renders of `spp` each, seeds firstSeed, firstSeed + 1, ...; the scene is read once.
 test::BatchEstimate renderBatches(const SceneData& data, const RenderJobSettings& base, int batches, uint64_t firstSeed,
                                   uint64_t* guideSamples = nullptr, uint64_t* discarded = nullptr,
-                                  uint64_t* branches = nullptr, int* windowed = nullptr, int* learned = nullptr) {
+                                  uint64_t* branches = nullptr, int* windowed = nullptr, int* learned = nullptr,
+                                  int* guidesLearned = nullptr) {
   std::vector<Image> images;
   for (int b = 0; b < batches; ++b) {
     RenderJobSettings s = base;
@@ -57,6 +58,7 @@ test::BatchEstimate renderBatches(const SceneData& data, const RenderJobSettings
     if (branches) *branches += r.branches;
     if (windowed && r.windowFromPass > 0) ++*windowed;
     if (learned && r.learnedBsdfProbability >= 0.0) ++*learned;
+    if (guidesLearned && r.learnedGuideShare > 0.0) ++*guidesLearned;
     images.push_back(r.image);
   }
   return test::estimateFromBatches(images);
@@ -70,6 +72,8 @@ struct Case {
   // mis as Hua & Low (the Markov chain's directions), or with each cache point's BSDF probability learned.
   enum class Mis { Default, Chain, Learned } mis = Mis::Default;
   int connectPaths = -1;  // VPL connections' light paths per pass; -1: the mode's default (settings())
+  // The VPL guide alone, or learned from the paths with the VPLs as prior, or learned alone.
+  enum class Guide { Vpl, Learned, LearnedOnly } guide = Guide::Vpl;
 };
 
 std::string caseName(const Case& c) {
@@ -78,7 +82,8 @@ std::string caseName(const Case& c) {
   return scene + "_" + modeName(c.mode) + (c.guidedVertices == 0 ? "_every_vertex" : "") +
          (c.roulette == RouletteRule::Vpl ? "_vpl_roulette" : c.roulette == RouletteRule::Auto ? "_auto_roulette" : "") +
          (c.mis == Case::Mis::Chain ? "_chain" : c.mis == Case::Mis::Learned ? "_learned" : "") +
-         (c.connectPaths == 0 ? "_no_connections" : c.connectPaths > 0 ? "_connections" : "");
+         (c.connectPaths == 0 ? "_no_connections" : c.connectPaths > 0 ? "_connections" : "") +
+         (c.guide == Case::Guide::Learned ? "_learned_guide" : c.guide == Case::Guide::LearnedOnly ? "_learned_only_guide" : "");
 }
 
 class GuidedModes : public ::testing::TestWithParam<Case> {};
@@ -91,13 +96,16 @@ TEST_P(GuidedModes, AgreeWithBsdfSamplingPixelByPixel) {
   const test::BatchEstimate reference =
       renderBatches(data, settings(c.scene, SamplingMode::Brdf, kSpp, 0), kBatches, 1000);
   uint64_t guideSamples = 0, discarded = 0, branches = 0;
-  int windowed = 0, learned = 0;
+  int windowed = 0, learned = 0, guidesLearned = 0;
   RenderJobSettings s = settings(c.scene, c.mode, kSpp, 0, c.guidedVertices, c.roulette, c.connectPaths);
   s.guide.misChain = c.mis == Case::Mis::Chain;
   s.guide.learnSelection = c.mis == Case::Mis::Learned;
-  const test::BatchEstimate guided =
-      renderBatches(data, s, kBatches, 2000, &guideSamples, &discarded, &branches, &windowed, &learned);
+  s.guide.learnDirections = c.guide != Case::Guide::Vpl;
+  s.guide.vplPrior = c.guide != Case::Guide::LearnedOnly;
+  const test::BatchEstimate guided = renderBatches(data, s, kBatches, 2000, &guideSamples, &discarded, &branches,
+                                                   &windowed, &learned, &guidesLearned);
   if (c.mis == Case::Mis::Learned) EXPECT_EQ(learned, kBatches) << "no cache point learned its probability";
+  if (c.guide != Case::Guide::Vpl) EXPECT_EQ(guidesLearned, kBatches) << "no guide learned from the paths";
   if (c.mode != SamplingMode::Brdf) EXPECT_GT(guideSamples, 0u) << "the guide was never used";
   if (c.roulette == RouletteRule::Vpl || c.roulette == RouletteRule::Auto) EXPECT_GT(branches, 0u) << "no path was ever split";
   if (c.roulette == RouletteRule::Auto) EXPECT_EQ(windowed, kBatches) << "the auto rule did not switch to the window";
@@ -133,7 +141,12 @@ INSTANTIATE_TEST_SUITE_P(
                       // VPL connections: off in a guided mode (the paper's setting), on in brdf.
                       Case{"two_rooms.gltf", SamplingMode::Mis, 1, RouletteRule::Sqrt, Case::Mis::Default, 0},
                       Case{"door_ajar.gltf", SamplingMode::Brdf, 1, RouletteRule::Sqrt, Case::Mis::Default, 128},
-                      Case{"cornell_glossy.gltf", SamplingMode::Brdf, 1, RouletteRule::Vpl, Case::Mis::Default, 128}),
+                      Case{"cornell_glossy.gltf", SamplingMode::Brdf, 1, RouletteRule::Vpl, Case::Mis::Default, 128},
+                      // Guides learned from the paths, with the VPLs as prior or alone.
+                      Case{"two_rooms.gltf", SamplingMode::Mis, 1, RouletteRule::Sqrt, Case::Mis::Default, -1, Case::Guide::Learned},
+                      Case{"door_ajar.gltf", SamplingMode::Mixture, 1, RouletteRule::Sqrt, Case::Mis::Default, -1, Case::Guide::Learned},
+                      Case{"cornell_glossy.gltf", SamplingMode::Metropolis, 1, RouletteRule::Sqrt, Case::Mis::Default, -1,
+                           Case::Guide::LearnedOnly}),
     [](const auto& info) { return caseName(info.param); });
 
 // The statistic is not blind: BSDF sampling against itself passes, and against itself 5 % brighter

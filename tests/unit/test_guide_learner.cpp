@@ -1,0 +1,129 @@
+// The learned guide (render/guide/guide_learner.h): the VPLs decide the first pass, the paths' records
+// move the guide to where the light really comes from, and every learned table keeps an exact pdf.
+#include <cmath>
+#include <vector>
+#include <gtest/gtest.h>
+#include "render/guide/guide_learner.h"
+#include "render/sampling/rng.h"
+#include "tests/unit/support.h"
+
+namespace vpl {
+namespace {
+
+const glm::vec3 kPriorDirection(0, 0, 1);     // where the VPLs say the light is
+const glm::vec3 kLightDirection(-1, 0, 0);    // where it really is
+constexpr float kLightCos = 0.95f;            // a cone of 18 degrees around it
+
+GuideSettings settings() { return GuideSettings{}; }
+
+// Cache point 0 has a VPL prior towards +z, cache point 1 none (no cluster reached it).
+GuideField field() {
+  const GuideSettings s = settings();
+  std::vector<CachePoint> points(2);
+  points[0].distribution = GuideDistribution({{kPriorDirection, 1.0f, 0.0f}}, s.coneAngle, s.defensive);
+  points[1].position = glm::vec3(10, 0, 0);
+  points[1].distribution = GuideDistribution(std::vector<GuideRepresentative>{}, s.coneAngle, s.defensive);
+  for (CachePoint& p : points) p.radius = 1.0f;
+  return GuideField(points, s);
+}
+
+// What a first vertex brings back: light of radiance 1 in the cone around kLightDirection.
+float incoming(const glm::vec3& w) { return glm::dot(w, kLightDirection) >= kLightCos ? 1.0f : 0.0f; }
+
+// `passes` passes of `perPass` first vertices at cache point c, each drawn from the pass's guide
+// and logged as F / q, spread over two tiles.
+void learn(GuideLearner& learner, int c, int passes, int perPass, uint64_t seed) {
+  Rng rng(seed);
+  for (int pass = 0; pass < passes; ++pass) {
+    for (int i = 0; i < perPass; ++i) {
+      const GuideDistribution& d = learner.distribution(c);
+      const glm::vec3 w = d.sample(rng);
+      learner.tileLog(uint32_t(i % 2)).add(c, w, incoming(w) / d.pdf(w));
+    }
+    learner.update();
+  }
+}
+
+double integral(const GuideDistribution& d) {
+  double sum = 0.0;
+  for (int cell = 0; cell < GuideDistribution::kCells; ++cell)
+    sum += double(d.pdf(GuideDistribution::cellCentre(cell))) * GuideDistribution::kCellSolidAngle;
+  return sum;
+}
+
+TEST(GuideLearner, ThePriorDecidesTheFirstPass) {
+  const GuideField f = field();
+  const GuideLearner withPrior(f, 2, true), learnedOnly(f, 2, false);
+  for (const glm::vec3& w : {kPriorDirection, kLightDirection, glm::normalize(glm::vec3(1, 2, -3))}) {
+    EXPECT_EQ(withPrior.distribution(0).pdf(w), f.point(0).distribution.pdf(w));
+    EXPECT_NEAR(learnedOnly.distribution(0).pdf(w), 1.0 / (4.0 * M_PI), 1e-6);
+  }
+}
+
+TEST(GuideLearner, MovesTheGuideToWhereTheLightComesFrom) {
+  const GuideField f = field();
+  for (const bool prior : {true, false}) {
+    GuideLearner learner(f, 2, prior);
+    const double before = learner.distribution(0).pdf(kLightDirection);
+    learn(learner, 0, 16, 256, 3);
+    const GuideDistribution& d = learner.distribution(0);
+    // 4096 samples against the prior's 64: the light's cells hold nearly all of the table.
+    EXPECT_GT(d.pdf(kLightDirection), 20.0 * before) << (prior ? "vpl prior" : "no prior");
+    EXPECT_GT(d.pdf(kLightDirection), 30.0 * d.pdf(kPriorDirection)) << (prior ? "vpl prior" : "no prior");
+    EXPECT_NEAR(learner.meanLearnedShare(), prior ? 0.5 * 4096.0 / (4096.0 + GuideLearner::kPriorSamples) : 0.5, 1e-9);
+  }
+}
+
+TEST(GuideLearner, KeepsThePriorWhereNothingWasFound) {
+  const GuideField f = field();
+  GuideLearner learner(f, 1, true);
+  for (int i = 0; i < 100; ++i) learner.tileLog(0).add(0, kPriorDirection, 0.0f);
+  learner.tileLog(0).add(0, kPriorDirection, NAN);  // counts as nothing found
+  learner.update();
+  EXPECT_EQ(learner.distribution(0).pdf(kPriorDirection), f.point(0).distribution.pdf(kPriorDirection));
+}
+
+// Learned tables are sampled exactly by both samplers and integrate to 1, with and without a prior
+// and at the cache point whose prior was empty.
+TEST(GuideLearner, LearnedPdfStaysExact) {
+  const GuideField f = field();
+  for (const bool prior : {true, false}) {
+    GuideLearner learner(f, 2, prior);
+    for (int c : {0, 1}) {
+      learn(learner, c, 3, 128, 5 + uint64_t(c));  // few samples: prior and learned cells both weigh
+      const GuideDistribution& d = learner.distribution(c);
+      const std::string name = std::string(prior ? "vpl prior" : "no prior") + ", cache point " + std::to_string(c);
+      ASSERT_FALSE(d.uniform()) << name << ": nothing was learned";
+      EXPECT_NEAR(integral(d), 1.0, 1e-4) << name;
+      Rng rng(11);
+      const auto pdf = [&](const glm::vec3& w) { return double(d.pdf(w)); };
+      const auto one = test::chiSquareEqualArea([&] { return d.sample(rng); }, pdf, 200000, 2 * GuideDistribution::kResolution);
+      EXPECT_GT(one.pValue, 1e-4) << name << ": " << one.report;
+      const auto two = test::chiSquareEqualArea([&] { return d.sample(rng.uniform2()); }, pdf, 200000,
+                                                2 * GuideDistribution::kResolution);
+      EXPECT_GT(two.pValue, 1e-4) << name << ": " << two.report;
+    }
+  }
+}
+
+// A learned cell is a block of the guide's fine cells: a direction's learned cell holds its fine cell.
+TEST(GuideLearner, LearnedCellsAreBlocksOfFineCells) {
+  Rng rng(9);
+  std::vector<int> blockOf(GuideDistribution::kCells, -1);
+  for (int i = 0; i < 100000; ++i) {
+    const glm::vec3 w = GuideDistribution::pointInCell(int(rng.uniform() * GuideDistribution::kCells) % GuideDistribution::kCells,
+                                                       rng.uniform2());
+    const int fine = GuideDistribution::cellOf(w), learned = GuideLearner::cellOf(w);
+    ASSERT_GE(learned, 0);
+    ASSERT_LT(learned, GuideLearner::kCells);
+    if (blockOf[size_t(fine)] < 0) blockOf[size_t(fine)] = learned;
+    EXPECT_EQ(blockOf[size_t(fine)], learned) << "fine cell " << fine;
+  }
+  std::vector<int> fineCount(GuideLearner::kCells, 0);
+  for (int b : blockOf)
+    if (b >= 0) ++fineCount[size_t(b)];
+  for (int n : fineCount) EXPECT_EQ(n, GuideDistribution::kCells / GuideLearner::kCells);
+}
+
+}  // namespace
+}  // namespace vpl
