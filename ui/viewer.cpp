@@ -75,6 +75,9 @@ struct PanelSettings {
   float uniformMutation;
   int roulette;  // index into kRoulettes
   bool connections;  // VPL connections in the guided modes
+  bool learnedJoins;  // ... joined to vertices chosen by what earlier passes learned (else uniformly)
+  bool learnGuides;   // guides learn from the paths between passes
+  bool vplPrior;      // ... starting from the VPL guide (else from a uniform one)
 };
 
 constexpr RouletteRule kRoulettes[] = {RouletteRule::Auto, RouletteRule::Sqrt, RouletteRule::Throughput, RouletteRule::Vpl};
@@ -139,7 +142,8 @@ int runViewer(const ViewerOptions& options) {
                         settings.guide.coneAngle * 57.29578f, settings.guide.bsdfProbability, settings.guide.learnSelection,
                         settings.guide.defensive,
                         settings.guide.uniformMutation, rouletteIndex(settings.tracer.roulette),
-                        settings.connections.paths != 0};
+                        settings.connections.paths != 0, settings.connections.learnChoice,
+                        settings.guide.learnDirections, settings.guide.vplPrior};
 
     Image image, variance;
     uint64_t version = 0;
@@ -230,6 +234,8 @@ int runViewer(const ViewerOptions& options) {
                     static_cast<unsigned long long>(stats.discarded), stats.rouletteWindow ? "VPL window" : settings.tracer.roulette == RouletteRule::Throughput ? "throughput" : "sqrt");
         if (stats.mode == SamplingMode::Mis && stats.learnedBsdfProbability >= 0.0)
           ImGui::Text("MIS BSDF probability: %.2f (mean learned over cache points)", stats.learnedBsdfProbability);
+        if (isGuided(stats.mode) && stats.learnedGuideShare >= 0.0)
+          ImGui::Text("guides: %.0f %% learned from the paths (mean over cache points)", 100.0 * stats.learnedGuideShare);
         if (ImGui::CollapsingHeader("VPLs and guide")) {
           ImGui::InputInt("VPLs", &panel.vpls, 1024, 8192);
           ImGui::InputInt("clusters per slice", &panel.clusters, 10, 100);
@@ -240,6 +246,9 @@ int runViewer(const ViewerOptions& options) {
           ImGui::SliderFloat("uniform mutation", &panel.uniformMutation, 0.0f, 1.0f);
           ImGui::Combo("roulette", &panel.roulette, kRouletteNames, 4);
           ImGui::Checkbox("VPL connections (guided modes)", &panel.connections);
+          ImGui::Checkbox("learn which light vertex a join picks", &panel.learnedJoins);
+          ImGui::Checkbox("learn the guides from the paths", &panel.learnGuides);
+          ImGui::Checkbox("start learning from the VPL guide", &panel.vplPrior);
           if (ImGui::Button("apply (restarts)")) {
             SessionSettings next = settings;
             next.mode = stats.mode;
@@ -254,6 +263,9 @@ int runViewer(const ViewerOptions& options) {
             next.guide.uniformMutation = std::clamp(panel.uniformMutation, 0.0f, 1.0f);
             next.tracer.roulette = kRoulettes[std::clamp(panel.roulette, 0, 3)];
             if (panel.connections != (settings.connections.paths != 0)) next.connections.paths = panel.connections ? -1 : 0;
+            next.connections.learnChoice = panel.learnedJoins;
+            next.guide.learnDirections = panel.learnGuides;
+            next.guide.vplPrior = panel.vplPrior;
             session.reset();  // joins the old controller before the new one starts
             session = std::make_unique<ProgressiveSession>(scene, controller.camera(), next);
             settings = next;

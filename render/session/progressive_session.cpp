@@ -183,6 +183,7 @@ void ProgressiveSession::controllerLoop() {
       ++stats_.restarts;
       stats_.firstPreviewSeconds = stats_.refineStartSeconds = 0.0;
       stats_.learnedBsdfProbability = -1.0;
+      stats_.learnedGuideShare = -1.0;
     }
     state.key = request;
     arena.execute([&] { runUntilChanged(state, request); });
@@ -370,7 +371,11 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
       std::lock_guard lock(mutex_);
       stats_.learnedBsdfProbability = mine.learner->meanLearnedProbability();
     }
-    if (mine.guides) mine.guides->update();
+    if (mine.guides) {
+      mine.guides->update();
+      std::lock_guard lock(mutex_);
+      stats_.learnedGuideShare = mine.guides->meanLearnedShare();
+    }
     if (rule == RouletteRule::Auto && !mine.window.on() && WindowSwitch::updateDue(uint64_t(mine.complete)) &&
         mine.window.update(*mine.film)) {
       renderer.reset();

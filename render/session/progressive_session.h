@@ -67,6 +67,7 @@ struct SessionStats {
   uint64_t restarts = 0;
   bool rouletteWindow = false;  // the film shown uses the VPL weight window (--roulette vpl, or auto switched)
   double learnedBsdfProbability = -1.0;  // mis: mean learned BSDF probability over cache points (-1: none yet)
+  double learnedGuideShare = -1.0;       // learned guides: mean weight of the learned part against the prior (-1: off)
 };
 
 class ProgressiveSession {
