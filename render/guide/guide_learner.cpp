@@ -36,19 +36,26 @@ GuideDistribution GuideLearner::blend(int c) const {
   double learnedTotal = 0.0;
   for (double s : sums) learnedTotal += s;
   const GuideDistribution& prior = field_.point(c).distribution;
-  const float defensive = field_.settings().defensive;
   const bool hasPrior = vplPrior_ && !prior.uniform();
   if (!(learnedTotal > 0.0)) return hasPrior ? prior : current_[size_t(c)];  // nothing found yet: no evidence against
   const double n = double(samples_[size_t(c)]);
   const double lambda = vplPrior_ ? n / (n + kPriorSamples) : 1.0;
+  // The prior's mass per learned cell: within a learned cell, its mass goes half to the fine cells
+  // as the prior shares it among them (the VPLs see detail finer than the paths can learn for
+  // long) and half evenly (the prior may be wrong inside the cell too).
+  std::array<double, kCells> priorInBlock{};
+  if (hasPrior)
+    for (int f = 0; f < GuideDistribution::kCells; ++f) priorInBlock[size_t(learnedCellOfFine(f))] += prior.cellShare(f);
   constexpr double kFineCells = double(kFinePerLearned * kFinePerLearned);
   std::vector<float> weights(GuideDistribution::kCells);
   for (int f = 0; f < GuideDistribution::kCells; ++f) {
+    const size_t b = size_t(learnedCellOfFine(f));
     const double priorShare = hasPrior ? prior.cellShare(f) : 1.0 / GuideDistribution::kCells;
-    const double learnedShare = sums[size_t(learnedCellOfFine(f))] / (learnedTotal * kFineCells);
-    weights[size_t(f)] = float((1.0 - lambda) * priorShare + lambda * learnedShare);
+    const double withinBlock = priorInBlock[b] > 0.0 ? 0.5 * prior.cellShare(f) / priorInBlock[b] + 0.5 / kFineCells
+                                                     : 1.0 / kFineCells;
+    weights[size_t(f)] = float((1.0 - lambda) * priorShare + lambda * sums[b] / learnedTotal * withinBlock);
   }
-  return GuideDistribution(weights, defensive);
+  return GuideDistribution(weights, field_.settings().defensive);
 }
 
 void GuideLearner::update() {
