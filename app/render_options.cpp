@@ -123,8 +123,8 @@ void RenderOptions::addCommonTo(CLI::App& command) {
       });
   command.add_option_function<std::string>(
             "--guide-learning", [this](const std::string& v) { guide.learnDirections = v == "on"; },
-            "guided modes: on: each cache point's guide learns from what the paths bring back between passes, "
-            "starting from the VPLs' | off: the VPL guide alone (Hua & Low)")
+            "guided modes: on (default): each cache point's guide learns from what the paths bring back between "
+            "passes, starting from the VPLs' | off: the VPL guide alone (Hua & Low)")
       ->check(CLI::IsMember({"on", "off"}));
   command.add_option_function<std::string>(
             "--guide-prior", [this](const std::string& v) { guide.vplPrior = v == "vpl"; },
