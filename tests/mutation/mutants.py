@@ -82,8 +82,8 @@ MUTANTS = [
      "  d.guide = pBsdf < 1.0f ? field_.point(c).distribution.pdf(wi) : 0.0f;",
      "directions drawn from the learned guide weighted by the VPL guide's pdf"),
     ("learned-guide-records-in-the-wrong-cell", "render/guide/guide_learner.cpp",
-     "    const double learnedShare = sums[size_t(learnedCellOfFine(f))] / (learnedTotal * kFineCells);",
-     "    const double learnedShare = sums[size_t(learnedCellOfFine(GuideDistribution::kCells - 1 - f))] / (learnedTotal * kFineCells);",
+     "      sums_[size_t(r.cachePoint)][r.cell] += double(r.value);",
+     "      sums_[size_t(r.cachePoint)][kCells - 1 - r.cell] += double(r.value);",
      "the learned guide puts what a direction brought back on the opposite side of the sphere"),
 ]
 
