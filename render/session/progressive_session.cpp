@@ -8,6 +8,7 @@
 #include "render/film/film.h"
 #include "render/guide/guide_builder.h"
 #include "render/integrator/guided_continuation.h"
+#include "render/session/film_learners.h"
 #include "render/session/tile_renderer.h"
 #include "render/session/window_switch.h"
 
@@ -59,8 +60,7 @@ struct ProgressiveSession::CameraState {
     uint64_t nextPass = 0;  // passes started (a cancelled pass still used its index)
     int complete = 0;
     WindowSwitch window;  // the auto roulette rule's decision for this film
-    std::unique_ptr<SelectionLearner> learner;  // mis: each cache point's BSDF probability, from this film's passes
-    std::unique_ptr<GuideLearner> guides;       // each cache point's guide, learned from this film's passes
+    std::unique_ptr<FilmLearners> learners;     // what this film's passes teach the guided continuations
     std::unique_ptr<LightVertexCache> joins;    // VPL connections: its choice of vertices learns from this film's passes
   };
   std::optional<Request> key;
@@ -313,11 +313,9 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
   if (isGuided(request.mode)) {
     const GuideField& guide = *state.guide;
     const SamplingMode mode = request.mode;
-    if (mode == SamplingMode::Mis && settings_.guide.learnSelection && !mine.learner)
-      mine.learner = std::make_unique<SelectionLearner>(guide.size(), TileRenderer::tileCountFor(w, h), settings_.guide.bsdfProbability);
-    if (settings_.guide.learnDirections && !mine.guides)
-      mine.guides = std::make_unique<GuideLearner>(guide, TileRenderer::tileCountFor(w, h), settings_.guide.vplPrior);
-    continuation = guidedContinuations(guide, mode, {mine.learner.get(), mine.guides.get()});
+    if (!mine.learners)
+      mine.learners = std::make_unique<FilmLearners>(guide, mode, settings_.guide, TileRenderer::tileCountFor(w, h));
+    continuation = guidedContinuations(guide, mode, mine.learners->logs());
   }
   const RouletteRule rule = settings_.tracer.roulette;
   // VPL connections: fresh light vertices before every pass, for tracers of this refinement only.
@@ -366,15 +364,11 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
     }
     if (cancelled()) return;
     ++mine.complete;
-    if (mine.learner) {
-      mine.learner->update();
+    if (mine.learners) {
+      mine.learners->update();
       std::lock_guard lock(mutex_);
-      stats_.learnedBsdfProbability = mine.learner->meanLearnedProbability();
-    }
-    if (mine.guides) {
-      mine.guides->update();
-      std::lock_guard lock(mutex_);
-      stats_.learnedGuideShare = mine.guides->meanLearnedShare();
+      stats_.learnedBsdfProbability = mine.learners->meanBsdfProbability();
+      stats_.learnedGuideShare = mine.learners->meanGuideShare();
     }
     if (rule == RouletteRule::Auto && !mine.window.on() && WindowSwitch::updateDue(uint64_t(mine.complete)) &&
         mine.window.update(*mine.film)) {

@@ -12,6 +12,7 @@
 #include "render/integrator/guided_continuation.h"
 #include "render/scene/camera.h"
 #include "render/scene/gltf_loader.h"
+#include "render/session/film_learners.h"
 #include "render/session/tile_renderer.h"
 #include "render/session/window_switch.h"
 #include "render/vpl/irradiance_grid.h"
@@ -111,8 +112,7 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
       vplRoulette ? windowTracer() : std::make_unique<PathTracer>(scene, settings.tracer, nullptr, connections);
   VplField field;
   GuideField guide;
-  std::optional<SelectionLearner> learner;  // mis: each cache point's BSDF probability, from the passes so far
-  std::optional<GuideLearner> guideLearner;  // each cache point's guide, from the passes so far
+  std::optional<FilmLearners> learners;  // what the passes so far teach the guided continuations
   std::function<PixelShaderFactory(const PathTracer&)> shaderFor;
   if (settings.mode != SamplingMode::Brdf) {
     const auto t = Clock::now();
@@ -139,12 +139,8 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
       result.timings.cluster = secondsSince(t);
       result.guideBytes = guide.memoryBytes();
       const SamplingMode mode = settings.mode;
-      if (mode == SamplingMode::Mis && settings.guide.learnSelection)
-        learner.emplace(guide.size(), TileRenderer::tileCountFor(settings.width, settings.height), settings.guide.bsdfProbability);
-      if (settings.guide.learnDirections)
-        guideLearner.emplace(guide, TileRenderer::tileCountFor(settings.width, settings.height), settings.guide.vplPrior);
-      const ContinuationFactory continuation = guidedContinuations(
-          guide, mode, {learner ? &*learner : nullptr, guideLearner ? &*guideLearner : nullptr});
+      learners.emplace(guide, mode, settings.guide, TileRenderer::tileCountFor(settings.width, settings.height));
+      const ContinuationFactory continuation = guidedContinuations(guide, mode, learners->logs());
       shaderFor = [continuation](const PathTracer& t) { return pathTracerShader(t, continuation); };
     }
   } else {
@@ -184,10 +180,9 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
     if (timed && pass > 0 && stop.load()) break;  // cut short: not a complete pass
     ++result.spp;
     if (pass == 0) result.firstImageSeconds = secondsSince(loaded);
-    if (learner) learner->update();
-    if (guideLearner) {
+    if (learners) {
       const auto t = Clock::now();
-      guideLearner->update();
+      learners->update();
       result.timings.guideLearning += secondsSince(t);
     }
     if (autoRoulette && !window.on() && WindowSwitch::updateDue(uint64_t(result.spp))) {
@@ -201,8 +196,10 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
     if (progress) progress(timed ? std::min(1.0, secondsSince(loaded) / settings.timeBudget) : double(pass + 1) / settings.spp);
   }
   watch.reset();
-  if (learner) result.learnedBsdfProbability = learner->meanLearnedProbability();
-  if (guideLearner) result.learnedGuideShare = guideLearner->meanLearnedShare();
+  if (learners) {
+    result.learnedBsdfProbability = learners->meanBsdfProbability();
+    result.learnedGuideShare = learners->meanGuideShare();
+  }
   result.timings.render = secondsSince(renderStart);
   result.seconds = secondsSince(loaded);
   result.image = film.resolve();

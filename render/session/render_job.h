@@ -38,7 +38,7 @@ struct PhaseTimings {
   // cluster's parts: gather points, slice tree, LightSlice (reduced matrix, global clusters, per-slice
   // refinement) and, in the guided modes, the guide
   double gather = 0, slices = 0, matrix = 0, globalClusters = 0, refine = 0, guide = 0;
-  double guideLearning = 0;  // the learned guides' updates between passes (part of render)
+  double guideLearning = 0;  // the learners' updates between passes, guides and mis's probability (part of render)
 };
 
 struct RenderJobResult {
