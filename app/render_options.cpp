@@ -83,6 +83,9 @@ void RenderOptions::addCommonTo(CLI::App& command) {
             "VPL connections: which light vertex a camera vertex joins: learned (cells of the scene in proportion to "
             "what their joins brought back in earlier passes, 30 % uniform) | uniform")
       ->check(CLI::IsMember({"learned", "uniform"}));
+  command.add_option("--joins", connections.joinsPerVertex,
+                     "VPL connections: light vertices each camera vertex joins (one number, systematic over the choice)")
+      ->check(CLI::Range(1, 16));
   command.add_option("--sky", sky, "uniform sky radiance R,G,B; 0 turns it off (default: on only without lights)");
   command.add_option("--exposure", exposure, "PNG exposure in stops");
   command.add_option("--vpls", preview.vpl.count, "number of VPLs")->check(CLI::Range(0, 50'000'000));

@@ -18,6 +18,7 @@ int ConnectionSettings::pathsFor(int pixels, SamplingMode mode) const {
 
 std::string ConnectionSettings::validate() const {
   if (paths < -1 || paths > 16'777'216) return "connection paths must be -1 (auto), 0 (off) or up to 16,777,216";
+  if (joinsPerVertex < 1 || joinsPerVertex > LightVertexCache::kMaxJoinsPerVertex) return "joins per vertex must be between 1 and 16";
   return {};
 }
 
@@ -72,7 +73,7 @@ void LightVertexCache::learnFromLastPass() {
   const double learned = learnedShareFor(learnedTotal);
   for (size_t k = 0; k < size_t(kCells); ++k) {
     const double rate = learned > 0.0 && seen_[k] > 0.0 ? (learned_[k] / learnedTotal) / (seen_[k] / seenTotal) : 0.0;
-    const double count = (1.0 - learned) + learned * rate;
+    const double count = double(joinsPerVertex_) * ((1.0 - learned) + learned * rate);
     misFactor_[k] = connectionMis(float(std::min(count, double(kLargestMisCount))));
   }
 }
@@ -152,7 +153,7 @@ void LightVertexCache::chooseCells(int paths) {
   // The scale from the probability the float cumulative sums actually give each cell.
   for (size_t c = 0; c < cellOf_.size(); ++c) {
     const double width = double(cellCdf_[c]) - (c > 0 ? double(cellCdf_[c - 1]) : 0.0);
-    cellScale_.push_back(width > 0.0 ? float(double(cellCount_[c]) / (width * double(paths))) : 0.0f);
+    cellScale_.push_back(width > 0.0 ? float(double(cellCount_[c]) / (width * double(paths) * double(joinsPerVertex_))) : 0.0f);
   }
 }
 

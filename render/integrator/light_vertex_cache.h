@@ -48,6 +48,8 @@ struct ConnectionSettings {
   int paths = -1;
   // Joins pick vertices by what their cells brought back (true) or uniformly (false).
   bool learnChoice = true;
+  // Joins per camera vertex, systematic over the cells' choice: one number u picks (j + u) / n.
+  int joinsPerVertex = 1;
 
   int pathsFor(int pixels, SamplingMode mode) const;
   std::string validate() const;
@@ -72,7 +74,11 @@ class LightVertexCache {
   static constexpr int kCellsPerAxis = 8;
   static constexpr float kUniformShare = 0.3f;
 
-  explicit LightVertexCache(bool learnChoice = true) : learnChoice_(learnChoice) {}
+  static constexpr int kMaxJoinsPerVertex = 16;
+
+  explicit LightVertexCache(bool learnChoice = true, int joinsPerVertex = 1)
+      : learnChoice_(learnChoice), joinsPerVertex_(std::clamp(joinsPerVertex, 1, kMaxJoinsPerVertex)),
+        misFactor_(kCells, connectionMis(float(joinsPerVertex_))) {}
 
   // Traces `paths` light paths of pass `pass`, each with numbers of its own hashed from (seed,
   // pass, path), and takes what the joins of the earlier passes recorded into the cells' choice: the
@@ -81,6 +87,7 @@ class LightVertexCache {
   void build(const RenderScene& scene, uint64_t seed, uint64_t pass, int paths, int maxLength);
 
   bool empty() const { return vertices_.empty(); }
+  int joinsPerVertex() const { return joinsPerVertex_; }
   const std::vector<LightVertex>& vertices() const { return vertices_; }
   // The vertex for the number u in [0, 1); scale is one over its pick probability times the path
   // count (each camera vertex stands for one light path's worth of joins).
@@ -132,6 +139,7 @@ class LightVertexCache {
   void chooseCells(int paths);
 
   bool learnChoice_;
+  int joinsPerVertex_;
   std::vector<LightVertex> vertices_;  // grouped by cell
   // The non-empty cells: their first vertex, vertex count, pick probabilities (cumulative) and scale.
   std::vector<uint32_t> cellOf_, cellStart_, cellCount_;
@@ -139,7 +147,7 @@ class LightVertexCache {
   glm::vec3 low_{0.0f}, perUnit_{0.0f};  // the scene's box: cell coordinates
   std::vector<double> learned_ = std::vector<double>(kCells, 0.0);  // every pass so far, per cell
   std::vector<double> seen_ = std::vector<double>(kCells, 0.0);     // vertices, every pass so far, per cell
-  std::vector<float> misFactor_ = std::vector<float>(kCells, 1.0f);
+  std::vector<float> misFactor_;
   mutable std::vector<std::atomic<uint64_t>> pending_ = std::vector<std::atomic<uint64_t>>(kCells);  // this pass
   float learnedShare_ = 0.0f;
   uint64_t rays_ = 0;

@@ -1,6 +1,7 @@
 #include "render/integrator/path_tracer.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <vector>
 #include "render/core/color.h"
@@ -200,12 +201,19 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
 
       const Bsdf bsdf = scene_.bsdf(surface, wo);
       VertexSamples u(path.sampler, depth);
-      // The light vertex to join, picked now: next-event estimation's shadow ray hides its fetch.
-      const LightVertex* joinTo = nullptr;
-      float joinScale = 0.0f;
+      // The light vertices to join, picked now: next-event estimation's shadow ray hides their fetch.
+      // n joins take one number u each, (j + u) / n: systematic, so they spread over the choice.
+      std::array<const LightVertex*, LightVertexCache::kMaxJoinsPerVertex> joinTo;
+      std::array<float, LightVertexCache::kMaxJoinsPerVertex> joinScale;
+      int joins = 0;
       if (connections_ && depth + 2 <= settings_.maxDepth && !connections_->empty()) {
-        joinTo = &connections_->pick(u.connectionChoice(), joinScale);
-        for (size_t line = 0; line < sizeof(LightVertex); line += 64) __builtin_prefetch(reinterpret_cast<const char*>(joinTo) + line);
+        joins = connections_->joinsPerVertex();
+        const float uJoin = u.connectionChoice();
+        for (int j = 0; j < joins; ++j) {
+          joinTo[size_t(j)] = &connections_->pick((float(j) + uJoin) / float(joins), joinScale[size_t(j)]);
+          for (size_t line = 0; line < sizeof(LightVertex); line += 64)
+            __builtin_prefetch(reinterpret_cast<const char*>(joinTo[size_t(j)]) + line);
+        }
       }
 
       // The weight window: roulette for paths worth little against the pixel, splitting for those
@@ -240,10 +248,11 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
         }
       }
 
-      // A join to one light vertex (the VPLs' share of the paths through here).
-      if (joinTo) {
-        const glm::vec3 joined = beta * connect(surface, bsdf, wo, path, continuation, *joinTo, joinScale, stats);
-        connections_->record(*joinTo, luminance(joined));
+      // Joins to light vertices (the VPLs' share of the paths through here).
+      for (int j = 0; j < joins; ++j) {
+        const LightVertex& y = *joinTo[size_t(j)];
+        const glm::vec3 joined = beta * connect(surface, bsdf, wo, path, continuation, y, joinScale[size_t(j)], stats);
+        connections_->record(y, luminance(joined));
         L += joined;
       }
 

@@ -25,7 +25,7 @@ struct Rendered {
 // connectPaths > 0: VPL connections to that many light paths per pass.
 Rendered renderScene(const RenderScene& scene, int width, int height, int spp, uint64_t seed, int maxDepth = 64,
                      RouletteRule roulette = PathTracerSettings{}.roulette, int rrStart = PathTracerSettings{}.rrStartDepth,
-                     int connectPaths = 0) {
+                     int connectPaths = 0, int joinsPerVertex = 1) {
   const Camera camera(defaultCamera(scene.data()), width, height);
   PathTracerSettings settings;
   settings.maxDepth = maxDepth;
@@ -33,7 +33,7 @@ Rendered renderScene(const RenderScene& scene, int width, int height, int spp, u
   settings.rrStartDepth = rrStart;
   IrradianceGrid irradiance;
   if (roulette == RouletteRule::Vpl) irradiance = IrradianceGrid(scene, 1 << 16, seed, maxDepth);
-  LightVertexCache connections;
+  LightVertexCache connections(true, joinsPerVertex);
   const PathTracer tracer(scene, settings, &irradiance, connectPaths > 0 ? &connections : nullptr);
   const TileRenderer renderer(camera, seed, pathTracerShader(tracer));
   Film film(width, height);
@@ -91,22 +91,25 @@ INSTANTIATE_TEST_SUITE_P(AlbedosAndRoulette, WhiteFurnace,
                                             ::testing::Values(1, 5)),
                          furnaceName);
 
-// VPL connections: every path is made by BSDF sampling, next-event estimation and a join at each
-// vertex, and the MIS weights of all of them must sum to 1, or the furnace's answer moves. Depth 3
-// also checks that no join makes a path longer than the limit (the answer is then the series'
-// first four terms).
+// VPL connections: every path is made by BSDF sampling, next-event estimation and the joins at each
+// vertex, and the MIS weights of all of them must sum to 1, or the furnace's answer moves (with 3
+// joins a vertex, the joins' count is 3 times as large on both sides). Depth 3 also checks that no
+// join makes a path longer than the limit (the answer is then the series' first four terms).
 TEST(WhiteFurnace, ConvergesWithVplConnections) {
   const float le = 0.5f;
-  for (const float rho : {0.5f, 0.8f}) {
-    for (const int depth : {3, 1024}) {
-      const RenderScene scene(test::furnaceScene(rho, le));
-      const Rendered r = renderScene(scene, 32, 32, 64, 11, depth, RouletteRule::Sqrt, 5, 512);
-      const double expected = depth == 3 ? le * (1.0 + rho + rho * rho + rho * rho * rho) : le / (1.0 - rho);
-      for (int c = 0; c < 3; ++c) {
-        const MeanAndError m = channelMean(r.image, c);
-        EXPECT_NEAR(m.mean, expected, 4.0 * m.error + 1e-3 * expected) << "rho " << rho << " depth " << depth << " channel " << c;
+  for (const int joins : {1, 3}) {
+    for (const float rho : {0.5f, 0.8f}) {
+      for (const int depth : {3, 1024}) {
+        const RenderScene scene(test::furnaceScene(rho, le));
+        const Rendered r = renderScene(scene, 32, 32, 64, 11, depth, RouletteRule::Sqrt, 5, 512, joins);
+        const double expected = depth == 3 ? le * (1.0 + rho + rho * rho + rho * rho * rho) : le / (1.0 - rho);
+        for (int c = 0; c < 3; ++c) {
+          const MeanAndError m = channelMean(r.image, c);
+          EXPECT_NEAR(m.mean, expected, 4.0 * m.error + 1e-3 * expected)
+              << "joins " << joins << " rho " << rho << " depth " << depth << " channel " << c;
+        }
+        EXPECT_EQ(r.stats.discarded, 0u);
       }
-      EXPECT_EQ(r.stats.discarded, 0u);
     }
   }
 }
