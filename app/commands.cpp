@@ -80,6 +80,10 @@ nlohmann::ordered_json summaryJson(const RenderJobSettings& s, const RenderJobRe
     else if (r.learnedBsdfProbability >= 0.0) j["bsdf_prob"] = r.learnedBsdfProbability;
     else j["bsdf_prob"] = nullptr;
   }
+  if (r.connectionPaths > 0) {
+    j["connect_paths"] = r.connectionPaths;
+    j["joins_per_vertex"] = s.connections.joinsPerVertex;
+  }
   if (s.tracer.roulette == RouletteRule::Vpl || s.tracer.roulette == RouletteRule::Auto)
     j["branches_per_sample"] = r.samples > 0 ? double(r.branches) / double(r.samples) : 0.0;
   if (s.tracer.roulette == RouletteRule::Auto) j["window_from_pass"] = r.windowFromPass;

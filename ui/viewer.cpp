@@ -14,6 +14,7 @@
 #include "render/core/error.h"
 #include "render/core/stopwatch.h"
 #include "render/film/image_io.h"
+#include "render/integrator/light_vertex_cache.h"
 #include "render/scene/camera.h"
 #include "render/scene/gltf_loader.h"
 #include "ui/camera_controller.h"
@@ -76,6 +77,7 @@ struct PanelSettings {
   int roulette;  // index into kRoulettes
   bool connections;  // VPL connections in the guided modes
   bool learnedJoins;  // ... joined to vertices chosen by what earlier passes learned (else uniformly)
+  int joinsPerVertex;  // ... this many per camera vertex
   bool learnGuides;   // guides learn from the paths between passes
   bool vplPrior;      // ... starting from the VPL guide (else from a uniform one)
 };
@@ -142,7 +144,7 @@ int runViewer(const ViewerOptions& options) {
                         settings.guide.coneAngle * 57.29578f, settings.guide.bsdfProbability, settings.guide.learnSelection,
                         settings.guide.defensive,
                         settings.guide.uniformMutation, rouletteIndex(settings.tracer.roulette),
-                        settings.connections.paths != 0, settings.connections.learnChoice,
+                        settings.connections.paths != 0, settings.connections.learnChoice, settings.connections.joinsPerVertex,
                         settings.guide.learnDirections, settings.guide.vplPrior};
 
     Image image, variance;
@@ -247,6 +249,7 @@ int runViewer(const ViewerOptions& options) {
           ImGui::Combo("roulette", &panel.roulette, kRouletteNames, 4);
           ImGui::Checkbox("VPL connections (guided modes)", &panel.connections);
           ImGui::Checkbox("learn which light vertex a join picks", &panel.learnedJoins);
+          ImGui::SliderInt("joins per camera vertex", &panel.joinsPerVertex, 1, LightVertexCache::kMaxJoinsPerVertex);
           ImGui::Checkbox("learn the guides from the paths", &panel.learnGuides);
           ImGui::Checkbox("start learning from the VPL guide", &panel.vplPrior);
           if (ImGui::Button("apply (restarts)")) {
@@ -264,6 +267,7 @@ int runViewer(const ViewerOptions& options) {
             next.tracer.roulette = kRoulettes[std::clamp(panel.roulette, 0, 3)];
             if (panel.connections != (settings.connections.paths != 0)) next.connections.paths = panel.connections ? -1 : 0;
             next.connections.learnChoice = panel.learnedJoins;
+            next.connections.joinsPerVertex = std::clamp(panel.joinsPerVertex, 1, LightVertexCache::kMaxJoinsPerVertex);
             next.guide.learnDirections = panel.learnGuides;
             next.guide.vplPrior = panel.vplPrior;
             session.reset();  // joins the old controller before the new one starts

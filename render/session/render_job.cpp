@@ -99,6 +99,7 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
     result.notices.push_back("VPL connections are off: they do not support the sky or lights with a range");
   LightVertexCache connectionCache(settings.connections.learnChoice, settings.connections.joinsPerVertex);
   const LightVertexCache* connections = connecting ? &connectionCache : nullptr;
+  if (connecting) result.connectionPaths = connectionPaths;
   // The VPL weight window's estimate and a tracer that uses it: at once for the vpl rule, when the
   // switch turns on for auto.
   IrradianceGrid irradiance;

@@ -54,6 +54,7 @@ struct RenderJobResult {
   uint64_t proposals = 0, accepted = 0;  // Metropolis mutations
   uint64_t branches = 0;                 // extra paths grown by splitting (the vpl roulette rule)
   int windowFromPass = 0;                // the auto rule: the window's first pass (0: never used)
+  int connectionPaths = 0;               // VPL connections: light paths per pass (0: none)
   double learnedBsdfProbability = -1.0;  // mis: the mean learned BSDF probability over cache points (-1: none)
   double learnedGuideShare = -1.0;       // learned guides: the mean weight of what was learned against the VPLs
   size_t guideBytes = 0;

@@ -85,6 +85,10 @@ MUTANTS = [
      "      sums_[size_t(r.cachePoint)][r.cell] += double(r.value);",
      "      sums_[size_t(r.cachePoint)][kCells - 1 - r.cell] += double(r.value);",
      "the learned guide puts what a direction brought back on the opposite side of the sphere"),
+    ("joins-weigh-one-each", "render/integrator/light_vertex_cache.cpp",
+     "    cellScale_.push_back(width > 0.0 ? float(double(cellCount_[c]) / (width * double(paths) * double(joinsPerVertex_))) : 0.0f);",
+     "    cellScale_.push_back(width > 0.0 ? float(double(cellCount_[c]) / (width * double(paths))) : 0.0f);",
+     "each of a vertex's joins weighs as much as a lone join, so light carried by joins counts twice"),
 ]
 
 
