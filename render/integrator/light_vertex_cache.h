@@ -1,7 +1,7 @@
 // VPL connections: the light vertices a camera path connects to (bidirectional path tracing with a
 // light vertex cache, Davidovič et al. 2014). Each pass traces fresh light paths from the emitters,
 // as instant radiosity does for its VPLs, and keeps every vertex they reach. A camera vertex joins
-// one of them (see "Which vertex" below); multiple importance sampling (the balance of all ways to make a
+// a few of them (ConnectionSettings::joinsPerVertex; see "Which vertex" below); multiple importance sampling (the balance of all ways to make a
 // path: BSDF sampling, next-event estimation, connection at each vertex; power heuristic) weights
 // each connection, so the VPLs carry the light that reaches the camera's room through a door while
 // the short connections, which instant radiosity clamps, are left to the other strategies: no bias.
@@ -93,7 +93,7 @@ class LightVertexCache {
   int joinsPerVertex() const { return joinsPerVertex_; }
   const std::vector<LightVertex>& vertices() const { return vertices_; }
   // The vertex for the number u in [0, 1); scale is one over its pick probability times the path
-  // count (each camera vertex stands for one light path's worth of joins).
+  // count (each camera vertex stands for one light path's worth of joins) and the joins per vertex.
   const LightVertex& pick(float u, float& scale) const {
     const size_t c = std::min(cellCdf_.size() - 1,
                               size_t(std::upper_bound(cellCdf_.begin(), cellCdf_.end(), u) - cellCdf_.begin()));
