@@ -387,6 +387,7 @@ TEST(PixelSampler, DeterministicInSeedPixelIndexAndIndependentOfCallOrder) {
   // A vertex's paired decisions are the two coordinates of one slot, whichever is asked first.
   VertexSamples v(a, 2);
   EXPECT_EQ(v.guideCell(), a.get2D(2, VertexDimension::StrategyGuideCell).y);
+  EXPECT_EQ(v.connectionChoice(), strategy);
   EXPECT_EQ(v.strategy(), strategy);
   EXPECT_EQ(VertexSamples(b, 3).roulette(), a.get2D(3, VertexDimension::LightChoiceRoulette).y);
   EXPECT_EQ(VertexSamples(b, 3).lightChoice(), a.get2D(3, VertexDimension::LightChoiceRoulette).x);
