@@ -88,6 +88,7 @@ void LightVertexCache::build(const RenderScene& scene, uint64_t seed, uint64_t p
   cellCount_.clear();
   cellCdf_.clear();
   cellScale_.clear();
+  cellGuide_.clear();
   rays_ = 0;
   learnedShare_ = 0.0f;
   // No vertices where the tracer could not weight its joins (PathTracer ignores the cache there).
@@ -150,6 +151,12 @@ void LightVertexCache::chooseCells(int paths) {
     cellCdf_.push_back(float(cumulative));
   }
   cellCdf_.back() = 1.0f;
+  cellGuide_.resize(kGuidePerCell * cellCdf_.size());
+  for (size_t b = 0, c = 0; b < cellGuide_.size(); ++b) {
+    const float low = float(double(b) / double(cellGuide_.size()));
+    while (c + 1 < cellCdf_.size() && cellCdf_[c] <= low) ++c;
+    cellGuide_[b] = uint32_t(c);
+  }
   // The scale from the probability the float cumulative sums actually give each cell.
   for (size_t c = 0; c < cellOf_.size(); ++c) {
     const double width = double(cellCdf_[c]) - (c > 0 ? double(cellCdf_[c - 1]) : 0.0);
