@@ -97,7 +97,7 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
   const bool connecting = connectionPaths > 0 && scene.emitters().supportsConnections();
   if (connectionPaths > 0 && !connecting && !scene.emitters().empty())
     result.notices.push_back("VPL connections are off: they do not support the sky or lights with a range");
-  LightVertexCache connectionCache(settings.connections.learnChoice, settings.connections.joinsPerVertex);
+  LightVertexCache connectionCache(settings.connections);
   const LightVertexCache* connections = connecting ? &connectionCache : nullptr;
   if (connecting) result.connectionPaths = connectionPaths;
   // The VPL weight window's estimate and a tracer that uses it: at once for the vpl rule, when the
