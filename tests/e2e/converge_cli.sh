@@ -4,10 +4,11 @@
 # reference's own noise is 1/4 of the error at 0.8 s), the image mean stays within 2 % of the
 # reference's (measured spread 0.2-0.9 % between seeds at 215 spp), the plot is a PNG, and bad input
 # gets exit 2 with one line.
-# At 40x30 the relMSE of a few samples is ruled by the pixels on the light's edge: from n to 8n spp
-# it fell by only 0.5-1.45x in some seeds at n <= 5 (both modes), never less than 4.5x at n >= 16
+# At 40x30 the relMSE of a few samples is ruled by the pixels on the light's edge: at 8n spp it was
+# 0.5-1.45 of its value at n spp in some seeds for n <= 5 (both modes), at most 0.22 for n >= 16
 # (10 seeds). A slow build (ASan drew 1 spp in 0.1 s) therefore quadruples both budgets until the
 # short one draws 16 spp, so the check asks the same of every build.
+# Usage (CTest): converge_cli.sh PATH/TO/vplview REPO_ROOT.
 set -u
 exe=$1; repo=$2
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
