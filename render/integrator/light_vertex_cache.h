@@ -79,10 +79,9 @@ class LightVertexCache {
 
   static constexpr int kMaxJoinsPerVertex = 16;
 
-  explicit LightVertexCache(bool learnChoice = true, int joinsPerVertex = 1)
-      : learnChoice_(learnChoice), joinsPerVertex_(std::clamp(joinsPerVertex, 1, kMaxJoinsPerVertex)),
+  explicit LightVertexCache(const ConnectionSettings& s)
+      : learnChoice_(s.learnChoice), joinsPerVertex_(std::clamp(s.joinsPerVertex, 1, kMaxJoinsPerVertex)),
         misFactor_(kCells, connectionMis(float(joinsPerVertex_))) {}
-  explicit LightVertexCache(const ConnectionSettings& s) : LightVertexCache(s.learnChoice, s.joinsPerVertex) {}
 
   // Traces `paths` light paths of pass `pass`, each with numbers of its own hashed from (seed,
   // pass, path), and takes what the joins of the earlier passes recorded into the cells' choice: the

@@ -320,8 +320,7 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
   const RouletteRule rule = settings_.tracer.roulette;
   // VPL connections: fresh light vertices before every pass, for tracers of this refinement only.
   const int joinPaths = settings_.connections.pathsFor(w * h, request.mode);
-  if (joinPaths > 0 && !mine.joins)
-    mine.joins = std::make_unique<LightVertexCache>(settings_.connections);
+  if (joinPaths > 0 && !mine.joins) mine.joins = std::make_unique<LightVertexCache>(settings_.connections);
   std::optional<PathTracer> joinTracer, joinWindowTracer;
   auto refineTracer = [&]() -> const PathTracer& {
     const bool windowed = rule == RouletteRule::Vpl || (rule == RouletteRule::Auto && mine.window.on());

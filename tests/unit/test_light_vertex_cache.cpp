@@ -13,6 +13,9 @@ namespace vpl {
 namespace {
 
 constexpr int kPaths = 256;
+// One join per camera vertex: a pick's scale is then one over its probability times the paths.
+constexpr ConnectionSettings kOneJoin{.learnChoice = true, .joinsPerVertex = 1};
+constexpr ConnectionSettings kOneUniformJoin{.learnChoice = false, .joinsPerVertex = 1};
 
 // Each vertex's pick probability as its scale states it: scale = 1 / (probability x paths).
 std::vector<double> statedProbabilities(const LightVertexCache& cache) {
@@ -59,7 +62,7 @@ RenderScene cornellBox() { return RenderScene(loadGltf(test::sourceDir() + "/sce
 
 TEST(LightVertexCache, UniformChoiceGivesEveryVertexTheSameProbability) {
   const RenderScene scene = cornellBox();
-  LightVertexCache cache(false);
+  LightVertexCache cache(kOneUniformJoin);
   cache.build(scene, 1, 0, kPaths, 8);
   ASSERT_FALSE(cache.empty());
   for (size_t i = 0; i < cache.vertices().size(); ++i) cache.record(cache.vertices()[i], 5.0f);  // ignored
@@ -74,7 +77,7 @@ TEST(LightVertexCache, UniformChoiceGivesEveryVertexTheSameProbability) {
 // often, every other vertex keeps at least the uniform share, and each pick's scale is exact.
 TEST(LightVertexCache, LearnedChoiceDrawsEachVertexWithTheProbabilityItsScaleStates) {
   const RenderScene scene = cornellBox();
-  LightVertexCache cache;
+  LightVertexCache cache(kOneJoin);
   cache.build(scene, 1, 0, kPaths, 8);
   ASSERT_FALSE(cache.empty());
   EXPECT_EQ(cache.learnedShare(), 0.0f);  // nothing learned yet: uniform
@@ -106,7 +109,7 @@ TEST(LightVertexCache, LearnedChoiceDrawsEachVertexWithTheProbabilityItsScaleSta
 // What is recorded is summed as integers: the same records in another order give the same choice.
 TEST(LightVertexCache, RecordsInAnyOrderGiveTheSameChoice) {
   const RenderScene scene = cornellBox();
-  LightVertexCache forward, backward;
+  LightVertexCache forward(kOneJoin), backward(kOneJoin);
   forward.build(scene, 3, 0, kPaths, 8);
   backward.build(scene, 3, 0, kPaths, 8);
   const std::vector<LightVertex>& v = forward.vertices();

@@ -33,7 +33,7 @@ Rendered renderScene(const RenderScene& scene, int width, int height, int spp, u
   settings.rrStartDepth = rrStart;
   IrradianceGrid irradiance;
   if (roulette == RouletteRule::Vpl) irradiance = IrradianceGrid(scene, 1 << 16, seed, maxDepth);
-  LightVertexCache connections(true, joinsPerVertex);
+  LightVertexCache connections(ConnectionSettings{.joinsPerVertex = joinsPerVertex});
   const PathTracer tracer(scene, settings, &irradiance, connectPaths > 0 ? &connections : nullptr);
   const TileRenderer renderer(camera, seed, pathTracerShader(tracer));
   Film film(width, height);
