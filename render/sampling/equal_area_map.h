@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numbers>
 #include <glm/glm.hpp>
+#include "render/sampling/fast_trig.h"
 
 namespace vpl {
 
@@ -15,17 +16,19 @@ inline glm::vec3 equalAreaSquareToSphere(glm::vec2 p) {
   const float ap = std::abs(a), bp = std::abs(b);
   const float signedDistance = 1.0f - (ap + bp);  // > 0: upper hemisphere
   const float r = 1.0f - std::abs(signedDistance);
-  const float phi = (r == 0.0f ? 1.0f : (bp - ap) / r + 1.0f) * (std::numbers::pi_v<float> / 4.0f);
+  // The azimuth within the quadrant, in quarter turns of pi / 4: [0, 2].
+  const float turns = std::clamp(r == 0.0f ? 1.0f : (bp - ap) / r + 1.0f, 0.0f, 2.0f);
+  const fast::SinCos phi = fast::sinCosQuarterTurns(turns);
   const float z = std::copysign(1.0f - r * r, signedDistance);
   const float s = r * std::sqrt(std::max(0.0f, 2.0f - r * r));
-  return {std::copysign(std::cos(phi), a) * s, std::copysign(std::sin(phi), b) * s, z};
+  return {std::copysign(phi.cos, a) * s, std::copysign(phi.sin, b) * s, z};
 }
 
 // Inverse of equalAreaSquareToSphere for unit vectors; the result lies in [0, 1]^2.
 inline glm::vec2 equalAreaSphereToSquare(const glm::vec3& d) {
   const float x = std::abs(d.x), y = std::abs(d.y), z = std::abs(d.z);
   const float r = std::sqrt(std::max(0.0f, 1.0f - z));
-  const float phi = std::atan2(y, x) * (2.0f / std::numbers::pi_v<float>);  // [0, 1] within the quadrant
+  const float phi = fast::atan2Quadrant(y, x) * (2.0f / std::numbers::pi_v<float>);  // [0, 1] within the quadrant
   float v = phi * r, u = r - v;
   if (d.z < 0.0f) {
     std::swap(u, v);

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 #include <glm/glm.hpp>
+#include "render/sampling/fast_trig.h"
 
 namespace vpl {
 
@@ -32,15 +33,13 @@ inline float uniformHemispherePdf() { return 0.5f * kInvPi; }
 inline glm::vec2 sampleConcentricDisk(glm::vec2 u) {
   const glm::vec2 o = 2.0f * u - 1.0f;
   if (o.x == 0.0f && o.y == 0.0f) return {0.0f, 0.0f};
-  float r, theta;
+  // The angle is pi/4 (o.y / o.x) in the wedges about the x axis, pi/2 - pi/4 (o.x / o.y) about y.
   if (std::abs(o.x) > std::abs(o.y)) {
-    r = o.x;
-    theta = 0.25f * kPi * (o.y / o.x);
-  } else {
-    r = o.y;
-    theta = 0.5f * kPi - 0.25f * kPi * (o.x / o.y);
+    const fast::SinCos a = fast::sinCosOctant(0.25f * kPi * (o.y / o.x));
+    return o.x * glm::vec2(a.cos, a.sin);
   }
-  return r * glm::vec2(std::cos(theta), std::sin(theta));
+  const fast::SinCos a = fast::sinCosOctant(0.25f * kPi * (o.x / o.y));
+  return o.y * glm::vec2(a.sin, a.cos);
 }
 
 // Malley's method: project the disk up to the hemisphere.
