@@ -64,7 +64,9 @@ void LightVertexCache::learnFromLastPass() {
   // What the joins of the last pass brought back joins the sums of the passes before it.
   double learnedTotal = 0.0, seenTotal = 0.0;
   for (size_t k = 0; k < size_t(kCells); ++k) {
-    learned_[k] += double(pending_[k].exchange(0, std::memory_order_relaxed)) / double(kFixedPoint);
+    uint64_t sum = 0;
+    for (size_t lane = 0; lane < kRecordLanes; ++lane) sum += pending_[lane * size_t(kCells) + k].exchange(0, std::memory_order_relaxed);
+    learned_[k] += double(sum) / double(kFixedPoint);
     learnedTotal += learned_[k];
     seenTotal += seen_[k];
   }

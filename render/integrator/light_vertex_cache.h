@@ -108,7 +108,7 @@ class LightVertexCache {
   void record(const LightVertex& y, float contribution) const {
     if (!learnChoice_ || !(contribution > 0.0f)) return;
     const float clamped = std::min(contribution, kLargestRecord);  // a rare spike must not overflow the sum
-    pending_[y.cell].fetch_add(uint64_t(clamped * kFixedPoint), std::memory_order_relaxed);
+    pending_[recordLane() * size_t(kCells) + y.cell].fetch_add(uint64_t(clamped * kFixedPoint), std::memory_order_relaxed);
   }
   // connectionMis of the MIS count of a join whose light end is at p (in cell y.cell): see above.
   float misFactor(const glm::vec3& p) const { return misFactor_[cellOf(p)]; }
@@ -163,7 +163,16 @@ class LightVertexCache {
   std::vector<double> learned_ = std::vector<double>(kCells, 0.0);  // every pass so far, per cell
   std::vector<double> seen_ = std::vector<double>(kCells, 0.0);     // vertices, every pass so far, per cell
   std::vector<float> misFactor_;
-  mutable std::vector<std::atomic<uint64_t>> pending_ = std::vector<std::atomic<uint64_t>>(kCells);  // this pass
+  // This pass's sums, in kRecordLanes copies: the threads' records fall into different lanes (by
+  // the order in which they first record), so two cores do not pass the hot cells' cache lines back
+  // and forth. Lanes are still atomic: beyond kRecordLanes threads they are shared.
+  static constexpr size_t kRecordLanes = 16;
+  static size_t recordLane() {
+    static std::atomic<size_t> next{0};
+    static thread_local const size_t lane = next.fetch_add(1, std::memory_order_relaxed) % kRecordLanes;
+    return lane;
+  }
+  mutable std::vector<std::atomic<uint64_t>> pending_ = std::vector<std::atomic<uint64_t>>(kRecordLanes * kCells);
   float learnedShare_ = 0.0f;
   uint64_t rays_ = 0;
 };
