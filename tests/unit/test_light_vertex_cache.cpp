@@ -3,6 +3,7 @@
 // stay unbiased on whole scenes is WhiteFurnace.ConvergesWithVplConnections and the guided modes'
 // agreement with brdf (test_guided_modes), which join by the learned choice.
 #include <map>
+#include <thread>
 #include <vector>
 #include "render/integrator/light_vertex_cache.h"
 #include "render/sampling/rng.h"
@@ -118,6 +119,29 @@ TEST(LightVertexCache, RecordsInAnyOrderGiveTheSameChoice) {
   forward.build(scene, 3, 1, kPaths, 8);
   backward.build(scene, 3, 1, kPaths, 8);
   EXPECT_EQ(statedProbabilities(forward), statedProbabilities(backward));
+}
+
+// Records from several threads (each writes its own lane of the sums) give the choice that the same
+// records from one thread give.
+TEST(LightVertexCache, RecordsFromManyThreadsGiveTheSameChoiceAsFromOne) {
+  const RenderScene scene = cornellBox();
+  LightVertexCache single(kOneJoin), threaded(kOneJoin);
+  single.build(scene, 5, 0, kPaths, 8);
+  threaded.build(scene, 5, 0, kPaths, 8);
+  const auto value = [](size_t i) { return 0.2f + 0.53f * float(i % 5); };
+  for (size_t i = 0; i < single.vertices().size(); ++i) single.record(single.vertices()[i], value(i));
+  constexpr size_t kThreads = 4;
+  std::vector<std::thread> threads;
+  for (size_t t = 0; t < kThreads; ++t)
+    threads.emplace_back([&, t] {
+      const std::vector<LightVertex>& v = threaded.vertices();
+      for (size_t i = t; i < v.size(); i += kThreads) threaded.record(v[i], value(i));
+    });
+  for (std::thread& t : threads) t.join();
+  single.build(scene, 5, 1, kPaths, 8);
+  threaded.build(scene, 5, 1, kPaths, 8);
+  EXPECT_GT(threaded.learnedShare(), 0.0f);
+  EXPECT_EQ(statedProbabilities(single), statedProbabilities(threaded));
 }
 
 }  // namespace
