@@ -2,8 +2,8 @@
 //
 // A sample is (seed, pixel, index), the index counting the pixel's samples from 0 and never
 // restarting, so the image depends on nothing else (not threads, not tile order). Each decision
-// has a fixed slot: one 2D (or 1D) stream of sobol.h, its order shuffled (an Owen scramble of the
-// index) and its digits xor-scrambled by a hash of (seed, pixel, slot). The first 2^m samples of any slot in a pixel are stratified (a (0,m,2)-net),
+// has a fixed slot: one 2D (or 1D) stream of sobol.h, shuffled and Owen-scrambled by a hash of
+// (seed, pixel, slot). The first 2^m samples of any slot in a pixel are stratified (a (0,m,2)-net),
 // different slots and pixels are independent of each other. A slot costs about the same in 1D and
 // 2D, so two 1D decisions of a vertex share one 2D slot, jointly stratified.
 //
@@ -78,21 +78,22 @@ class PixelSampler {
     return kFirstVertexSlot + uint32_t(vertex) * uint32_t(VertexDimension::Count) + uint32_t(d);
   }
 
-  // One hash of (pixel, slot) gives the slot's shuffle and its first coordinate's scramble, a second
-  // the other's. The shuffled index comes out bit-reversed, which is the van der Corput point itself.
+  // One hash of (pixel, slot) gives the slot's shuffle and its scrambles.
   float get1D(uint32_t slot) const {
     if (independent_) return independent_->uniform();
     const uint64_t h = mix64(pixelKey_ + slot);
-    return sobol::toUnitFloat(shuffledReversed(uint32_t(h)) ^ uint32_t(h >> 32));
+    const uint32_t i = shuffledIndex(uint32_t(h));
+    return sobol::toUnitFloat(sobol::scrambledVanDerCorput(i, uint32_t(h >> 32)));
   }
   glm::vec2 get2D(uint32_t slot) const {
     if (independent_) return independent_->uniform2();
     const uint64_t h = mix64(pixelKey_ + slot), h2 = mix64(h);
-    const uint32_t r = shuffledReversed(uint32_t(h));
-    return {sobol::toUnitFloat(r ^ uint32_t(h >> 32)), sobol::toUnitFloat(sobol::sobolSecondOfReversed(r) ^ uint32_t(h2))};
+    const uint32_t i = shuffledIndex(uint32_t(h));
+    return {sobol::toUnitFloat(sobol::scrambledVanDerCorput(i, uint32_t(h >> 32))),
+            sobol::toUnitFloat(sobol::scrambledSobolSecond(i, uint32_t(h2)))};
   }
-  // sobol::shuffleIndex(index, seed) bit-reversed, the index's own reversal done once per sample.
-  uint32_t shuffledReversed(uint32_t seed) const { return sobol::nestedScrambleReversed(reversedIndex_, seed); }
+  // sobol::shuffleIndex(index, seed), its first bit reversal done once per sample.
+  uint32_t shuffledIndex(uint32_t seed) const { return sobol::reverseBits(sobol::nestedScrambleReversed(reversedIndex_, seed)); }
   float hashedUniform(uint32_t slot, uint32_t component) const {
     return float(mix64(sampleKey_ + 2u * uint64_t(slot) + component) >> 40) * 0x1p-24f;
   }

@@ -1,6 +1,5 @@
-// The Sobol' (0,2)-sequence, its order shuffled by a hash-based Owen scramble and its digits
-// scrambled: the generator behind every stratified number of the renderer (pixel_sampler.h decides
-// which decision draws from which dimension).
+// The Sobol' (0,2)-sequence with hash-based Owen scrambling: the generator behind every stratified
+// number of the renderer (pixel_sampler.h decides which decision draws from which dimension).
 //
 // Only the first two Sobol' dimensions are used: the van der Corput sequence and its partner whose
 // generator matrix is Pascal's triangle mod 2. Together they form a (0,2)-sequence in base 2: every
@@ -45,7 +44,7 @@ inline constexpr std::array<uint32_t, 32> kSecondDirections = [] {
 
 // The index byte by byte: kSecondByByte[b][x] is the xor of the direction numbers of the bits set
 // in x as byte b of the index (4 KB, made at compile time), four reads instead of a loop over bits.
-// Stored bit-reversed: sobolSecond() reverses it back (the tests' reference for the table below).
+// Stored bit-reversed, the form the scramble below works in.
 inline constexpr auto kSecondByByte = [] {
   std::array<std::array<uint32_t, 256>, 4> table{};
   for (int b = 0; b < 4; ++b)
@@ -60,23 +59,6 @@ inline constexpr auto kSecondByByte = [] {
     }
   return table;
 }();
-
-// The second dimension from the index's bit reversal r, in the normal order: kSecondByReversedByte[b][x]
-// is the xor of the direction numbers of the index bits that bits 8b..8b+7 of r stand for (bit k of r
-// is bit 31 - k of the index). A shuffled index comes out of the scramble reversed: this spares
-// reversing it back.
-inline constexpr auto kSecondByReversedByte = [] {
-  std::array<std::array<uint32_t, 256>, 4> table{};
-  for (int b = 0; b < 4; ++b)
-    for (uint32_t x = 0; x < 256; ++x)
-      for (int bit = 0; bit < 8; ++bit)
-        if (x & (1u << bit)) table[size_t(b)][x] ^= kSecondDirections[size_t(31 - 8 * b - bit)];
-  return table;
-}();
-inline uint32_t sobolSecondOfReversed(uint32_t r) {
-  return kSecondByReversedByte[0][r & 0xffu] ^ kSecondByReversedByte[1][(r >> 8) & 0xffu] ^
-         kSecondByReversedByte[2][(r >> 16) & 0xffu] ^ kSecondByReversedByte[3][r >> 24];
-}
 
 inline uint32_t reversedSobolSecond(uint32_t index) {
   return kSecondByByte[0][index & 0xffu] ^ kSecondByByte[1][(index >> 8) & 0xffu] ^
@@ -100,13 +82,12 @@ inline uint32_t nestedScrambleReversed(uint32_t x, uint32_t seed) {
 }
 inline uint32_t owenScramble(uint32_t v, uint32_t seed) { return reverseBits(nestedScrambleReversed(reverseBits(v), seed)); }
 
-// The sampler's points (pixel_sampler.h) are not Owen-scrambled: a shuffled index's two coordinates
-// are xor-ed with random seeds (random digit scrambling, Matousek 1998): each binary digit flipped
-// or not at random, the same way for every point, which also keeps nets nets and makes each point
-// uniform. Owen's scramble converges faster on smooth integrands; on renders (32 spp, five scenes,
-// seeds 1 and 2) brdf's relMSE per sample was 0.98-1.04 of Owen's with the xor, but a sample took
-// 0.90-0.93 of the time: Owen's needs the shuffled index back in the normal bit order and a
-// scramble per coordinate: a chain of two bit reversals and two scrambles more per point.
+// The scrambled points themselves. The van der Corput point of index i reversed is i itself, so each
+// costs one bit reversal.
+inline uint32_t scrambledVanDerCorput(uint32_t index, uint32_t seed) { return reverseBits(nestedScrambleReversed(index, seed)); }
+inline uint32_t scrambledSobolSecond(uint32_t index, uint32_t seed) {
+  return reverseBits(nestedScrambleReversed(reversedSobolSecond(index), seed));
+}
 
 // A shuffle of the sequence's order (Burley 2020): the same scramble applied to the index itself,
 // most significant bit first. The first 2^m indices, whose high bits are all zero, map to one aligned

@@ -128,16 +128,6 @@ TEST(Sobol, FirstTwoDimensionsAreA02Sequence) {
     }
 }
 
-// The sampler reads the second dimension from the reversed index (the shuffle's output): the same
-// point as from the index itself, over the whole range of indices.
-TEST(Sobol, SecondDimensionFromTheReversedIndexIsTheSamePoint) {
-  for (uint64_t k = 0; k < (uint64_t(1) << 32); k += 0x1003u) {
-    const uint32_t index = uint32_t(k) ^ uint32_t(k >> 7);
-    ASSERT_EQ(sobol::sobolSecondOfReversed(sobol::reverseBits(index)), sobol::sobolSecond(index)) << index;
-  }
-  EXPECT_EQ(sobol::sobolSecondOfReversed(0xffffffffu), sobol::sobolSecond(0xffffffffu));
-}
-
 TEST(Sobol, ShuffleMapsEveryPrefixOntoAnAlignedBlock) {
   for (uint32_t seed : {0u, 1u, 0xdeadbeefu, 0x9e3779b9u})
     for (int m = 0; m <= 14; ++m) {
@@ -192,7 +182,7 @@ TEST(PixelSampler, FirstSamplesOfEverySlotAreStratified) {
     }
 }
 
-// The digit scramble makes every single sample uniform over [0,1)^d: across pixels, sample k of a slot
+// Owen scrambling makes every single sample uniform over [0,1)^d: across pixels, sample k of a slot
 // is uniform for every k (what keeps each pixel's estimate unbiased). A "too good" fit would mean the
 // pixels' scrambles are related, so both tails are checked.
 TEST(PixelSampler, EverySampleIsUniformAcrossPixels) {
