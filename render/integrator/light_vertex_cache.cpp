@@ -65,7 +65,7 @@ void LightVertexCache::learnFromLastPass() {
   double learnedTotal = 0.0, seenTotal = 0.0;
   for (size_t k = 0; k < size_t(kCells); ++k) {
     uint64_t sum = 0;
-    for (size_t lane = 0; lane < kRecordLanes; ++lane) sum += pending_[lane * size_t(kCells) + k].exchange(0, std::memory_order_relaxed);
+    for (size_t lane = 0; lane < kRecordLanes; ++lane) sum += pending(lane, k).exchange(0, std::memory_order_relaxed);
     learned_[k] += double(sum) / double(kFixedPoint);
     learnedTotal += learned_[k];
     seenTotal += seen_[k];

@@ -108,7 +108,7 @@ class LightVertexCache {
   void record(const LightVertex& y, float contribution) const {
     if (!learnChoice_ || !(contribution > 0.0f)) return;
     const float clamped = std::min(contribution, kLargestRecord);  // a rare spike must not overflow the sum
-    pending_[recordLane() * size_t(kCells) + y.cell].fetch_add(uint64_t(clamped * kFixedPoint), std::memory_order_relaxed);
+    pending(recordLane(), y.cell).fetch_add(uint64_t(clamped * kFixedPoint), std::memory_order_relaxed);
   }
   // connectionMis of the MIS count of a join whose light end is at p (in cell y.cell): see above.
   float misFactor(const glm::vec3& p) const { return misFactor_[cellOf(p)]; }
@@ -173,6 +173,7 @@ class LightVertexCache {
     return lane;
   }
   mutable std::vector<std::atomic<uint64_t>> pending_ = std::vector<std::atomic<uint64_t>>(kRecordLanes * kCells);
+  std::atomic<uint64_t>& pending(size_t lane, size_t cell) const { return pending_[lane * size_t(kCells) + cell]; }
   float learnedShare_ = 0.0f;
   uint64_t rays_ = 0;
 };
