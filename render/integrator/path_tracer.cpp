@@ -167,6 +167,8 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
     const int depth = path.depth;
     bool ended = true;
     do {
+      VertexSamples u(path.sampler, depth);
+      u.drawAhead();
       const RayHit hit = scene_.accel().intersect(ray);
       ++stats.rays;
 
@@ -200,7 +202,6 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
       if (depth + 1 > settings_.maxDepth) break;
 
       const Bsdf bsdf = scene_.bsdf(surface, wo);
-      VertexSamples u(path.sampler, depth);
       // The light vertices to join, picked now: next-event estimation's shadow ray hides their fetch.
       // n joins take one number u each, (j + u) / n: systematic, so they spread over the choice.
       std::array<const LightVertex*, LightVertexCache::kMaxJoinsPerVertex> joinTo;

@@ -60,17 +60,14 @@ size_t AliasTable::sample(float u, float* pmf, float* uRemapped) const {
   const size_t bin = std::min(size_t(x), n - 1);
   const double rest = std::min(x - double(bin), 1.0);  // in [0, 1)
   const Bin& b = bins_[bin];
-  size_t i;
-  double remapped;
-  if (rest < b.keep) {
-    i = bin;
-    remapped = rest / b.keep;
-  } else {
-    i = b.alias;
-    remapped = (rest - b.keep) / (1.0 - b.keep);
-  }
+  const bool kept = rest < b.keep;
+  const size_t i = kept ? bin : b.alias;
   if (pmf) *pmf = bins_[i].pmf;
-  if (uRemapped) *uRemapped = float(std::clamp(remapped, 0.0, double(0x1.fffffep-1f)));
+  // Two divisions, most callers' largest cost here: only for those who reuse the number.
+  if (uRemapped) {
+    const double remapped = kept ? rest / b.keep : (rest - b.keep) / (1.0 - b.keep);
+    *uRemapped = float(std::clamp(remapped, 0.0, double(0x1.fffffep-1f)));
+  }
   return i;
 }
 

@@ -4,8 +4,8 @@
 // restarting, so the image depends on nothing else (not threads, not tile order). Each decision
 // has a fixed slot: one 2D (or 1D) stream of sobol.h, shuffled and Owen-scrambled by a hash of
 // (seed, pixel, slot). The first 2^m samples of any slot in a pixel are stratified (a (0,m,2)-net),
-// different slots and pixels are independent of each other. A slot costs about the same in 1D and
-// 2D, so two 1D decisions of a vertex share one 2D slot, jointly stratified.
+// different slots and pixels are independent of each other. Two 1D decisions of a vertex share one
+// 2D slot, jointly stratified; the second is computed only when asked (most vertices ask for one).
 //
 // Slot layout: the camera jitter, the preview's cluster choice, then per path vertex (its depth:
 // 0 is the camera ray's hit) a block of VertexDimension. Past kTabulatedVertices, and for consumers
@@ -56,6 +56,37 @@ class PixelSampler {
     const uint32_t slot = slotOf(vertex, d);
     return (vertex < kTabulatedVertices && !branch_) || independent_ ? get2D(slot)
                                                                      : glm::vec2(hashedUniform(slot, 0), hashedUniform(slot, 1));
+  }
+  // A slot shared by two decisions of which most vertices read only the first (light choice and
+  // roulette, joins and guide cell): its second coordinate is computed when asked, the same number
+  // get2D() gives.
+  class Pair {
+   public:
+    float x() const { return x_; }
+    float y() {
+      if (y_ < 0.0f) y_ = sobol::toUnitFloat(sobol::scrambledSobolSecond(index_, uint32_t(mix64(slotHash_))));
+      return y_;
+    }
+
+   private:
+    friend class PixelSampler;
+    float x_ = 0.0f, y_ = -1.0f;  // y_ < 0: not computed yet
+    uint32_t index_ = 0;          // the slot's shuffled sample index
+    uint64_t slotHash_ = 0;
+  };
+  Pair getPair(int vertex, VertexDimension d) {
+    const uint32_t slot = slotOf(vertex, d);
+    Pair p;
+    if ((vertex < kTabulatedVertices && !branch_) && !independent_) {
+      p.slotHash_ = mix64(pixelKey_ + slot);
+      p.index_ = shuffledIndex(uint32_t(p.slotHash_));
+      p.x_ = sobol::toUnitFloat(sobol::scrambledVanDerCorput(p.index_, uint32_t(p.slotHash_ >> 32)));
+    } else {
+      const glm::vec2 u = get2D(vertex, d);
+      p.x_ = u.x;
+      p.y_ = u.y;
+    }
+    return p;
   }
   // The numbers of a branch that a split path grows (render/integrator/weight_window.h): the
   // branches of one vertex must not share numbers, and the stratified dimensions belong to the
@@ -112,18 +143,25 @@ class VertexSamples {
   VertexSamples(PixelSampler& sampler, int vertex) : sampler_(sampler), vertex_(vertex) {}
 
   int vertex() const { return vertex_; }
-  glm::vec2 lightPoint() { return sampler_.get2D(vertex_, VertexDimension::LightPoint); }
-  glm::vec2 bsdfDirection() { return sampler_.get2D(vertex_, VertexDimension::BsdfDirection); }
-  float lightChoice() { return pair(lightChoiceRoulette_, VertexDimension::LightChoiceRoulette).x; }
-  float roulette() { return pair(lightChoiceRoulette_, VertexDimension::LightChoiceRoulette).y; }
-  float guideCell() { return pair(strategyGuideCell_, VertexDimension::StrategyGuideCell).y; }
+  glm::vec2 lightPoint() { return point(lightPoint_, VertexDimension::LightPoint); }
+  glm::vec2 bsdfDirection() { return point(bsdfDirection_, VertexDimension::BsdfDirection); }
+  float lightChoice() { return pair(lightChoiceRoulette_, VertexDimension::LightChoiceRoulette).x(); }
+  float roulette() { return pair(lightChoiceRoulette_, VertexDimension::LightChoiceRoulette).y(); }
+  float guideCell() { return pair(strategyGuideCell_, VertexDimension::StrategyGuideCell).y(); }
   glm::vec2 guidePoint() { return sampler_.get2D(vertex_, VertexDimension::GuidePoint); }
   // The light vertices a vertex joins (render/integrator/light_vertex_cache.h), stratified over the
   // pixel's samples: per sample at 32 spp (seeds 1, 2), relMSE 0.86 of a hashed number's on the Cornell
   // box, 0.94 on two_rooms, 0.99 on door_ajar.
-  float connectionChoice() { return pair(strategyGuideCell_, VertexDimension::StrategyGuideCell).x; }
+  float connectionChoice() { return pair(strategyGuideCell_, VertexDimension::StrategyGuideCell).x(); }
   // The same number, for a continuation strategy of its own where no joins are made (bench/portal_bound).
   float strategy() { return connectionChoice(); }
+  // The numbers every vertex reads, drawn before its ray is traced: their hash chains are long and
+  // independent of the hit, so the core works them out in the shadow of the traversal.
+  void drawAhead() {
+    lightPoint();
+    bsdfDirection();
+    lightChoice();
+  }
   // The vertex's own random stream (Metropolis chains), made on first use.
   Rng& random() {
     if (!random_) random_ = sampler_.random(vertex_);
@@ -131,14 +169,19 @@ class VertexSamples {
   }
 
  private:
-  glm::vec2 pair(std::optional<glm::vec2>& cached, VertexDimension d) {
+  glm::vec2 point(std::optional<glm::vec2>& cached, VertexDimension d) {
     if (!cached) cached = sampler_.get2D(vertex_, d);
+    return *cached;
+  }
+  PixelSampler::Pair& pair(std::optional<PixelSampler::Pair>& cached, VertexDimension d) {
+    if (!cached) cached = sampler_.getPair(vertex_, d);
     return *cached;
   }
 
   PixelSampler& sampler_;
   int vertex_;
-  std::optional<glm::vec2> lightChoiceRoulette_, strategyGuideCell_;
+  std::optional<glm::vec2> lightPoint_, bsdfDirection_;
+  std::optional<PixelSampler::Pair> lightChoiceRoulette_, strategyGuideCell_;
   std::optional<Rng> random_;
 };
 

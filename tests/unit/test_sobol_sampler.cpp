@@ -402,6 +402,28 @@ TEST(PixelSampler, DeterministicInSeedPixelIndexAndIndependentOfCallOrder) {
   EXPECT_EQ(independent.cameraJitter(), r2.uniform2());
 }
 
+// VertexSamples draws ahead and leaves a shared slot's second number until asked: neither may change
+// a number, at any vertex (tabulated, hashed past them, or a split path's branch).
+TEST(PixelSampler, DrawnAheadAndLazyNumbersAreGet2DsNumbers) {
+  for (uint64_t k = 0; k < 300; ++k) {
+    PixelSampler plain(9, 31 + k, k), sampler(9, 31 + k, k);
+    const PixelSampler branch = plain.branch(uint32_t(k + 1));
+    for (int vertex = 0; vertex < PixelSampler::kTabulatedVertices + 2; ++vertex) {
+      for (PixelSampler s : {sampler, branch}) {
+        PixelSampler reference = s;
+        VertexSamples v(s, vertex);
+        v.drawAhead();
+        ASSERT_EQ(v.lightPoint(), reference.get2D(vertex, VertexDimension::LightPoint));
+        ASSERT_EQ(v.bsdfDirection(), reference.get2D(vertex, VertexDimension::BsdfDirection));
+        ASSERT_EQ(v.roulette(), reference.get2D(vertex, VertexDimension::LightChoiceRoulette).y);
+        ASSERT_EQ(v.lightChoice(), reference.get2D(vertex, VertexDimension::LightChoiceRoulette).x);
+        ASSERT_EQ(v.connectionChoice(), reference.get2D(vertex, VertexDimension::StrategyGuideCell).x);
+        ASSERT_EQ(v.guideCell(), reference.get2D(vertex, VertexDimension::StrategyGuideCell).y);
+      }
+    }
+  }
+}
+
 // Past the tabulated vertices, and in the per-vertex streams, numbers are hashed random: uniform,
 // deterministic, different from vertex to vertex.
 TEST(PixelSampler, DeepVerticesAndStreamsAreUniformAndDeterministic) {
