@@ -34,12 +34,11 @@ inline glm::vec2 sampleConcentricDisk(glm::vec2 u) {
   const glm::vec2 o = 2.0f * u - 1.0f;
   if (o.x == 0.0f && o.y == 0.0f) return {0.0f, 0.0f};
   // The angle is pi/4 (o.y / o.x) in the wedges about the x axis, pi/2 - pi/4 (o.x / o.y) about y.
-  if (std::abs(o.x) > std::abs(o.y)) {
-    const fast::SinCos a = fast::sinCosOctant(0.25f * kPi * (o.y / o.x));
-    return o.x * glm::vec2(a.cos, a.sin);
-  }
-  const fast::SinCos a = fast::sinCosOctant(0.25f * kPi * (o.x / o.y));
-  return o.y * glm::vec2(a.sin, a.cos);
+  // Selects, not branches: the wedge is a coin flip per sample, which a branch predictor loses.
+  const bool aboutX = std::abs(o.x) > std::abs(o.y);
+  const float radius = aboutX ? o.x : o.y;
+  const fast::SinCos a = fast::sinCosOctant(0.25f * kPi * ((aboutX ? o.y : o.x) / radius));
+  return radius * glm::vec2(aboutX ? a.cos : a.sin, aboutX ? a.sin : a.cos);
 }
 
 // Malley's method: project the disk up to the hemisphere.
