@@ -85,7 +85,7 @@ float PathTracer::predictedRadiance(const SurfaceHit& surface, const Bsdf& bsdf)
 struct PathTracer::Branch {
   Ray ray;
   glm::vec3 beta{1.0f};
-  SurfaceHit previous;
+  glm::vec3 previousPosition{0.0f};  // where the ray that is traced left (a surface: the camera's is never needed)
   float previousPdf = 0.0f;
   int depth = 0;
   PixelSampler sampler;
@@ -95,10 +95,10 @@ struct PathTracer::Branch {
 float PathTracer::emitterHitWeight(const SurfaceHit& surface, const glm::vec3& wo, const Branch& path) const {
   if (path.depth == 0) return 1.0f;
   const EmitterSet& emitters = scene_.emitters();
-  if (!connections_) return powerHeuristic(path.previousPdf, emitters.pdfTriangle(path.previous.position, surface));
-  const glm::vec3 d = surface.position - path.previous.position;
+  if (!connections_) return powerHeuristic(path.previousPdf, emitters.pdfTriangle(path.previousPosition, surface));
+  const glm::vec3 d = surface.position - path.previousPosition;
   const float cosHit = std::abs(glm::dot(surface.geometricNormal, wo));
-  const float directPdfArea = emitters.pdfTriangle(path.previous.position, surface) * cosHit / glm::dot(d, d);
+  const float directPdfArea = emitters.pdfTriangle(path.previousPosition, surface) * cosHit / glm::dot(d, d);
   return bidirectionalWeight(connectionMis(directPdfArea) * path.dVCM + connectionMis(emitters.pdfEmission(surface, wo)) * path.dVC);
 }
 
@@ -160,7 +160,7 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
   float pixelEstimate = 0.0f;  // the weight window's reference, set at the camera ray's hit
   glm::vec3 firstContinuationStart(0.0f);  // L before the first vertex's continuation
 
-  Branch path{cameraRay, glm::vec3(1.0f), SurfaceHit{}, 0.0f, 0, sampler};
+  Branch path{cameraRay, glm::vec3(1.0f), glm::vec3(0.0f), 0.0f, 0, sampler};
   for (;;) {
     Ray& ray = path.ray;
     glm::vec3& beta = path.beta;
@@ -262,7 +262,7 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
       // The split's other branches first (each its own numbers), then this path's own continuation.
       const glm::vec3 branchBeta = beta / float(split);
       for (int b = 1; b < split; ++b) {
-        Branch next{Ray{}, glm::vec3(0.0f), surface, 0.0f, depth + 1, path.sampler.branch(nextBranchId++), path.dVC, path.dVCM};
+        Branch next{Ray{}, glm::vec3(0.0f), surface.position, 0.0f, depth + 1, path.sampler.branch(nextBranchId++), path.dVC, path.dVCM};
         VertexSamples ub(next.sampler, depth);
         DirectionSample dir;
         glm::vec3 weight;
@@ -293,7 +293,7 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
         beta /= survive;
       }
       if (connections_) advanceConnectionMis(path.dVC, path.dVCM, depth, surface, bsdf, wo, next);
-      path.previous = surface;
+      path.previousPosition = surface.position;
       path.previousPdf = next.pdf;
       ray = spawnRay(surface, next.wi);
       path.depth = depth + 1;
