@@ -50,12 +50,11 @@ class PixelSampler {
   // A slot read in 1D is the first coordinate of its 2D point.
   float get1D(int vertex, VertexDimension d) {
     const uint32_t slot = slotOf(vertex, d);
-    return (vertex < kTabulatedVertices && !branch_) || independent_ ? get1D(slot) : hashedUniform(slot, 0);
+    return stratified(vertex) || independent_ ? get1D(slot) : hashedUniform(slot, 0);
   }
   glm::vec2 get2D(int vertex, VertexDimension d) {
     const uint32_t slot = slotOf(vertex, d);
-    return (vertex < kTabulatedVertices && !branch_) || independent_ ? get2D(slot)
-                                                                     : glm::vec2(hashedUniform(slot, 0), hashedUniform(slot, 1));
+    return stratified(vertex) || independent_ ? get2D(slot) : glm::vec2(hashedUniform(slot, 0), hashedUniform(slot, 1));
   }
   // A slot shared by two decisions of which most vertices read only the first (light choice and
   // roulette, joins and guide cell): its second coordinate is computed when asked, the same number
@@ -77,7 +76,7 @@ class PixelSampler {
   Pair getPair(int vertex, VertexDimension d) {
     const uint32_t slot = slotOf(vertex, d);
     Pair p;
-    if ((vertex < kTabulatedVertices && !branch_) && !independent_) {
+    if (stratified(vertex) && !independent_) {
       p.slotHash_ = mix64(pixelKey_ + slot);
       p.index_ = shuffledIndex(uint32_t(p.slotHash_));
       p.x_ = sobol::toUnitFloat(sobol::scrambledVanDerCorput(p.index_, uint32_t(p.slotHash_ >> 32)));
@@ -105,6 +104,8 @@ class PixelSampler {
 
  private:
   static constexpr uint32_t kCameraSlot = 0, kPreviewClusterSlot = 1, kFirstVertexSlot = 2;
+  // A vertex whose numbers come from the stratified slots, not the hashed fallback.
+  bool stratified(int vertex) const { return vertex < kTabulatedVertices && !branch_; }
   static uint32_t slotOf(int vertex, VertexDimension d) {
     return kFirstVertexSlot + uint32_t(vertex) * uint32_t(VertexDimension::Count) + uint32_t(d);
   }
