@@ -74,17 +74,11 @@ class PixelSampler {
     uint64_t slotHash_ = 0;
   };
   Pair getPair(int vertex, VertexDimension d) {
-    const uint32_t slot = slotOf(vertex, d);
+    if (stratified(vertex) && !independent_) return stratifiedPair(slotOf(vertex, d));
+    const glm::vec2 u = get2D(vertex, d);
     Pair p;
-    if (stratified(vertex) && !independent_) {
-      p.slotHash_ = mix64(pixelKey_ + slot);
-      p.index_ = shuffledIndex(uint32_t(p.slotHash_));
-      p.x_ = sobol::toUnitFloat(sobol::scrambledVanDerCorput(p.index_, uint32_t(p.slotHash_ >> 32)));
-    } else {
-      const glm::vec2 u = get2D(vertex, d);
-      p.x_ = u.x;
-      p.y_ = u.y;
-    }
+    p.x_ = u.x;
+    p.y_ = u.y;
     return p;
   }
   // The numbers of a branch that a split path grows (render/integrator/weight_window.h): the
@@ -110,19 +104,20 @@ class PixelSampler {
     return kFirstVertexSlot + uint32_t(vertex) * uint32_t(VertexDimension::Count) + uint32_t(d);
   }
 
-  // One hash of (pixel, slot) gives the slot's shuffle and its scrambles.
-  float get1D(uint32_t slot) const {
-    if (independent_) return independent_->uniform();
-    const uint64_t h = mix64(pixelKey_ + slot);
-    const uint32_t i = shuffledIndex(uint32_t(h));
-    return sobol::toUnitFloat(sobol::scrambledVanDerCorput(i, uint32_t(h >> 32)));
+  // One hash of (pixel, slot) gives the slot's shuffle and its scrambles (the second coordinate's
+  // through Pair::y(), when asked).
+  Pair stratifiedPair(uint32_t slot) const {
+    Pair p;
+    p.slotHash_ = mix64(pixelKey_ + slot);
+    p.index_ = shuffledIndex(uint32_t(p.slotHash_));
+    p.x_ = sobol::toUnitFloat(sobol::scrambledVanDerCorput(p.index_, uint32_t(p.slotHash_ >> 32)));
+    return p;
   }
+  float get1D(uint32_t slot) const { return independent_ ? independent_->uniform() : stratifiedPair(slot).x(); }
   glm::vec2 get2D(uint32_t slot) const {
     if (independent_) return independent_->uniform2();
-    const uint64_t h = mix64(pixelKey_ + slot), h2 = mix64(h);
-    const uint32_t i = shuffledIndex(uint32_t(h));
-    return {sobol::toUnitFloat(sobol::scrambledVanDerCorput(i, uint32_t(h >> 32))),
-            sobol::toUnitFloat(sobol::scrambledSobolSecond(i, uint32_t(h2)))};
+    Pair p = stratifiedPair(slot);
+    return {p.x(), p.y()};
   }
   // sobol::shuffleIndex(index, seed), its first bit reversal done once per sample.
   uint32_t shuffledIndex(uint32_t seed) const { return sobol::reverseBits(sobol::nestedScrambleReversed(reversedIndex_, seed)); }
