@@ -15,7 +15,9 @@
 #
 # Environment: MODES ("brdf mis"; MODE+RULE runs with --roulette RULE, e.g. brdf+vpl), THREADS (2), SEEDS ("1 2"), MAX_DEPTH (32 = vplview's default; Cycles gets
 # --max-bounces MAX_DEPTH-1), SCENES (names to run, default all built-in), REF_SPP (overrides the
-# per-scene reference spp below), REF_THREADS (0 = all cores), CYCLES_RENDER (path of cycles-render),
+# per-scene reference spp below), REF_MODE (the reference's mode, brdf; mis converges to the same image
+# with far less error per second where the light arrives indirectly, so its reference is not the main
+# error of the mis row), REF_THREADS (0 = all cores), CYCLES_RENDER (path of cycles-render),
 # CODE (how the tables name the code measured; default: the repository's commit).
 # The reference cache is keyed by the scene's bytes, not by vplview's code: delete OUT_DIR/ref_*.exr
 # when a change alters what the renderer converges to.
@@ -28,7 +30,7 @@ budgets=${*:-10 60}
 here=$(cd "$(dirname "$0")/.." && pwd)
 exe=$build/vplview
 cycles=${CYCLES_RENDER:-$here/../shared/tools/cycles/cycles-render}
-MODES=${MODES:-brdf mis}; THREADS=${THREADS:-2}; SEEDS=${SEEDS:-1 2}; MAX_DEPTH=${MAX_DEPTH:-32}; REF_THREADS=${REF_THREADS:-0}
+MODES=${MODES:-brdf mis}; THREADS=${THREADS:-2}; SEEDS=${SEEDS:-1 2}; MAX_DEPTH=${MAX_DEPTH:-32}; REF_THREADS=${REF_THREADS:-0}; REF_MODE=${REF_MODE:-brdf}
 [ -x "$exe" ] || { echo "vs_cycles: no $exe (cmake --build BUILD_DIR --target vplview)" >&2; exit 2; }
 [ -x "$cycles" ] || { echo "vs_cycles: no $cycles (set CYCLES_RENDER)" >&2; exit 2; }
 command -v blender >/dev/null || { echo "vs_cycles: Blender is missing: apt-get install -y blender" >&2; exit 2; }
@@ -41,7 +43,7 @@ log=$out/vs_cycles.log
 csv=$out/vs_cycles.csv
 md=$out/vs_cycles.md
 skipped=$out/vs_cycles_skipped.txt
-header="scene,budget,renderer,mode,seed,seconds,spp,samples_per_s,relmse,bias,width,height,ref_spp"
+header="scene,budget,renderer,mode,seed,seconds,spp,samples_per_s,relmse,bias,width,height,ref_spp,ref_mode"
 
 # Sizes (the issue's measurements) and reference spp per scene; other scenes: 320x240, 8192 spp.
 size_of() { case $1 in cornell_box) echo "256 256";; *) echo "320 240";; esac; }
@@ -60,7 +62,7 @@ scenes = set(sys.argv[3].split())  # empty: every scene is rerun
 rows = list(csv.reader(open(sys.argv[1])))
 for r in rows[1:]:
     if r and (float(r[1]) not in rerun or (scenes and r[0] not in scenes)):
-        print(",".join(r))
+        print(",".join(r + ["brdf"] * (14 - len(r))))  # rows from before the ref_mode column
 PY
 fi
 mv "$tmp_csv" "$csv"
@@ -96,7 +98,7 @@ print(p, max(a - 16 * p, 0.0))" "${probe[@]}")
   echo "$name ${W}x$H: Cycles probes at 16 and 64 spp: ${probe[*]} s -> $per_spp s/spp + $fixed s" | tee -a "$log"
 
   rspp=$(ref_spp_of "$name")
-  ref=$(cached_reference "$exe" "$scene" "$name" "$out" "$W" "$H" "$rspp" "$MAX_DEPTH" "$REF_THREADS" 2>> "$log")
+  ref=$(cached_reference "$exe" "$scene" "$name" "$out" "$W" "$H" "$rspp" "$MAX_DEPTH" "$REF_THREADS" "$REF_MODE" 2>> "$log")
 
   for t in $budgets; do
     cspp=$(python3 -c "import sys; t, f, p = map(float, sys.argv[1:]); print(max(1, round((t - f) / p)))" "$t" "$fixed" "$per_spp")
@@ -106,7 +108,7 @@ print(p, max(a - 16 * p, 0.0))" "${probe[@]}")
                               --max-bounces $bounces --threads "$THREADS" | json seconds spp)
       read -r rel bias < <("$exe" compare "$img" "$ref" | json relmse bias)
       sps=$(python3 -c "import sys; w, h, n, s = map(float, sys.argv[1:]); print(f'{w * h * n / s:.6g}')" "$W" "$H" "$spp" "$secs")
-      echo "$name,$t,cycles,path,$seed,$secs,$spp,$sps,$rel,$bias,$W,$H,$rspp" | tee -a "$log" >> "$csv"
+      echo "$name,$t,cycles,path,$seed,$secs,$spp,$sps,$rel,$bias,$W,$H,$rspp,$REF_MODE" | tee -a "$log" >> "$csv"
       for mode in $MODES; do
         img=$out/${name}_${t}s_${mode}_seed$seed.exr
         flags="--mode ${mode%%+*}"
@@ -115,7 +117,7 @@ print(p, max(a - 16 * p, 0.0))" "${probe[@]}")
                                   --threads "$THREADS" --seed "$seed" --max-depth "$MAX_DEPTH" --out "$img" | json seconds spp)
         read -r rel bias < <("$exe" compare "$img" "$ref" | json relmse bias)
         sps=$(python3 -c "import sys; w, h, n, s = map(float, sys.argv[1:]); print(f'{w * h * n / s:.6g}')" "$W" "$H" "$vspp" "$vsecs")
-        echo "$name,$t,vplview,$mode,$seed,$vsecs,$vspp,$sps,$rel,$bias,$W,$H,$rspp" | tee -a "$log" >> "$csv"
+        echo "$name,$t,vplview,$mode,$seed,$vsecs,$vspp,$sps,$rel,$bias,$W,$H,$rspp,$REF_MODE" | tee -a "$log" >> "$csv"
       done
     done
   done
@@ -183,14 +185,15 @@ for scene, budget in keys:
         print(f"| {label} | {', '.join(r['seed'] for r in g)} | {mean(r['seconds'] for r in g):.1f} | {mean(r['spp'] for r in g):.0f} | "
               f"{fmt(sps)} | {', '.join('%.4g' % r['relmse'] for r in g)} | {rel:.4g} | {mean(r['bias'] for r in g):+.4f} | "
               f"{ratio(sps, mean(r['samples_per_s'] for r in c))} | {ratio(rel, mean(r['relmse'] for r in c))} |")
-    b = group(scene, budget, "vplview", "brdf")
     n = int(c[0]["ref_spp"]) if c else 0
+    ref_mode = (c[0].get("ref_mode") or "brdf") if c else "brdf"
+    b = group(scene, budget, "vplview", ref_mode)
     if b and n:
-        # An unbiased estimate's relMSE falls as 1/spp: the reference's own error is about brdf's times its spp / n,
-        # and it adds to every row's relMSE (pulling the ratios towards 1).
+        # An unbiased estimate's relMSE falls as 1/spp: the reference's own error is about its mode's row's times
+        # that row's spp / n, and it adds to every row's relMSE (pulling the ratios towards 1).
         est = mean(r["relmse"] for r in b) * mean(r["spp"] for r in b) / n
         low = min(r["relmse"] for r in rows if r["scene"] == scene and r["budget"] == budget)
-        print(f"\nReference: {n} spp vplview brdf; its own relMSE ≈ {est:.2g} (brdf's × spp / {n}), {100 * est / low:.0f} % of the lowest relMSE above.")
+        print(f"\nReference: {n} spp vplview {ref_mode}; its own relMSE ≈ {est:.2g} ({ref_mode}'s × spp / {n}), {100 * est / low:.0f} % of the lowest relMSE above.")
     print()
 if os.path.exists(skipped) and os.path.getsize(skipped):
     print("Skipped (no exact Cycles counterpart):\n")
