@@ -1,7 +1,6 @@
 #include "app/commands.h"
 
 #include <cstdio>
-#include <optional>
 #include <sstream>
 #include <unistd.h>
 #include <nlohmann/json.hpp>
@@ -102,9 +101,8 @@ RenderJobResult renderWithProgress(const RenderJobSettings& settings, const char
   return result;
 }
 
-int runRender(const RenderOptions& options, std::optional<SamplingMode> forcedMode = std::nullopt) {
-  RenderJobSettings settings = options.toSettings();
-  if (forcedMode) settings.mode = *forcedMode;
+int runRender(const RenderOptions& options) {
+  const RenderJobSettings settings = options.toSettings();
   tbb::global_control threads(tbb::global_control::max_allowed_parallelism, options.threadCount());
   // Check the outputs before spending minutes on a render that cannot be saved.
   checkWritable(options.out);
@@ -192,7 +190,7 @@ void registerCommands(CLI::App& app) {
   gRenderCommand = app.add_subcommand("render", "render a scene headlessly to EXR (and PNG)");
   gRender.addTo(*gRenderCommand, /*requireOut=*/true);
 
-  gReferenceCommand = app.add_subcommand("reference", "render a brdf reference for relMSE measurements (EXR; seed 1000 unless --seed)");
+  gReferenceCommand = app.add_subcommand("reference", "render a reference for relMSE measurements (EXR; brdf unless --mode, seed 1000 unless --seed)");
   gReference.addTo(*gReferenceCommand, /*requireOut=*/true);
 
   gConvergeCommand = app.add_subcommand("converge", "relMSE and bias of each mode against a reference at growing time budgets");
@@ -236,7 +234,7 @@ int runSelectedCommand(CLI::App& app) {
   if (gReferenceCommand->parsed()) {
     // Renders default to seed 1: a reference with the same random numbers would flatter them.
     if (gReferenceCommand->count("--seed") == 0) gReference.seed = kReferenceSeed;
-    return runRender(gReference, SamplingMode::Brdf);
+    return runRender(gReference);
   }
   if (gConvergeCommand->parsed()) return runConverge(gConvergeOnly, gConverge, *gConvergeCommand);
   if (gSweepCommand->parsed()) return runSweep(gSweepOnly, gSweep, *gSweepCommand);

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# vplview reference + converge end to end: the CSV has its header and one row per mode and budget,
+# vplview reference + converge end to end: the reference's mode is brdf unless --mode; the CSV has its header and one row per mode and budget,
 # samples grow with the budget, the error falls with it (8x the time: at least 2x less relMSE; the
 # reference's own noise is 1/4 of the error at 0.8 s), the image mean stays within 2 % of the
 # reference's (measured spread 0.2-0.9 % between seeds at 215 spp), the plot is a PNG, and bad input
@@ -14,7 +14,13 @@ exe=$1; repo=$2
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
 scene=$repo/scenes/cornell_box.gltf
 fail() { echo "FAIL: $*"; exit 1; }
-"$exe" reference "$scene" --spp 4096 --width 40 --height 30 --out "$tmp/ref.exr" >/dev/null || fail "reference"
+"$exe" reference "$scene" --spp 4096 --width 40 --height 30 --out "$tmp/ref.exr" > "$tmp/ref.json" || fail "reference"
+# A reference is brdf unless --mode says otherwise (a guided reference converges to the same image).
+python3 -c "import json,sys; assert json.loads(open(sys.argv[1]).read().splitlines()[-1])['mode'] == 'brdf'" "$tmp/ref.json" \
+  || fail "the default reference is not brdf"
+"$exe" reference "$scene" --mode mis --spp 1 --width 8 --height 8 --out "$tmp/mis.exr" > "$tmp/mis.json" || fail "mis reference"
+python3 -c "import json,sys; assert json.loads(open(sys.argv[1]).read().splitlines()[-1])['mode'] == 'mis'" "$tmp/mis.json" \
+  || fail "reference --mode mis rendered another mode"
 short=0.1
 for attempt in 1 2 3 4; do
   long=$(python3 -c "print($short * 8)")
