@@ -50,6 +50,8 @@ void RenderOptions::addViewerOptionsTo(CLI::App& app) {
 void RenderOptions::addConvergeTo(CLI::App& command) {
   command.add_option("scene", scene, "glTF 2.0 scene (.gltf or .glb)")->required();
   addCommonTo(command);
+  // These commands take their modes from --modes: a --mode here would be accepted and ignored.
+  command.remove_option(command.get_option("--mode"));
 }
 
 void RenderOptions::addCommonTo(CLI::App& command) {

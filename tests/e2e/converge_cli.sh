@@ -53,4 +53,7 @@ bad converge "$scene" --reference "$tmp/ref.exr" --modes brdf,nope --times 1 --o
 bad converge "$scene" --reference "$tmp/ref.exr" --times 1,-2 --out-dir "$tmp/x"
 bad converge "$scene" --reference "$tmp/missing.exr" --times 1 --out-dir "$tmp/x"
 bad converge "$scene" --reference "$tmp/ref.exr" --times 1 --width 41 --out-dir "$tmp/x"
+# --modes chooses converge's and sweep's modes: a --mode would otherwise be accepted and ignored.
+bad converge "$scene" --reference "$tmp/ref.exr" --times 1 --mode mis --out-dir "$tmp/x"
+bad sweep "$scene" --reference "$tmp/ref.exr" --times 1 --mode mis --vary --clusters=50,100 --out-dir "$tmp/x"
 echo "ok: converge and reference"
