@@ -86,6 +86,7 @@ nlohmann::ordered_json summaryJson(const RenderJobSettings& s, const RenderJobRe
   if (s.tracer.roulette == RouletteRule::Vpl || s.tracer.roulette == RouletteRule::Auto)
     j["branches_per_sample"] = r.samples > 0 ? double(r.branches) / double(r.samples) : 0.0;
   if (s.tracer.roulette == RouletteRule::Auto) j["window_from_pass"] = r.windowFromPass;
+  j["sampler"] = s.stratifiedSampler ? "sobol" : "random";
   j["seed"] = s.seed;
   j["threads"] = tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
   j["scene"] = s.scenePath;

@@ -89,6 +89,10 @@ void RenderOptions::addCommonTo(CLI::App& command) {
                      "VPL connections: light vertices each camera vertex joins (one number, systematic over the choice)")
       ->check(CLI::Range(1, 16));
   command.add_option("--sky", sky, "uniform sky radiance R,G,B; 0 turns it off (default: on only without lights)");
+  command.add_option("--sampler", sampler,
+                     "the camera paths' numbers: sobol (stratified: Owen-scrambled Sobol', one slot per decision) | "
+                     "random (independent random numbers at every slot, as the paper's sampler: an ablation)")
+      ->check(CLI::IsMember({"sobol", "random"}));
   command.add_option("--exposure", exposure, "PNG exposure in stops");
   command.add_option("--vpls", preview.vpl.count, "number of VPLs")->check(CLI::Range(0, 50'000'000));
   command.add_option("--slice-size", sliceSize, "largest slice, in gather points (default: 256 preview, 512 guided modes)")
@@ -158,6 +162,7 @@ RenderJobSettings RenderOptions::toSettings() const {
                       : roulette == "auto" ? RouletteRule::Auto
                                            : RouletteRule::Throughput;
   s.connections = connections;
+  s.stratifiedSampler = sampler != "random";
   s.preview = preview;
   if (sliceSize > 0)
     s.preview.slices.maxSliceSize = sliceSize;

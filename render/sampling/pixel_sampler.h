@@ -34,10 +34,13 @@ class PixelSampler {
  public:
   static constexpr int kTabulatedVertices = 8;
 
-  PixelSampler(uint64_t seed, uint64_t pixel, uint64_t sampleIndex)
+  // `stratified` false: every slot draws from the hashed fallback, independent random numbers as the
+  // paper's sampler had, so what the stratification buys stays measurable (`--sampler random`).
+  PixelSampler(uint64_t seed, uint64_t pixel, uint64_t sampleIndex, bool stratified = true)
       : pixelKey_(mix64(mix64(seed ^ 0x736f626f6c000000ull) ^ pixel) ^ mix64(sampleIndex >> 32)),
         sampleKey_(mix64(pixelKey_ ^ sampleIndex)),
-        reversedIndex_(sobol::reverseBits(uint32_t(sampleIndex))) {}
+        reversedIndex_(sobol::reverseBits(uint32_t(sampleIndex))),
+        hashedOnly_(!stratified) {}
   // Independent random numbers, all from `rng` in the order asked: for callers that bring their own
   // stream (benches, and as the baseline the stratified samples are measured against).
   explicit PixelSampler(Rng& rng) : independent_(&rng) {}
@@ -99,7 +102,7 @@ class PixelSampler {
  private:
   static constexpr uint32_t kCameraSlot = 0, kPreviewClusterSlot = 1, kFirstVertexSlot = 2;
   // A vertex whose numbers come from the stratified slots, not the hashed fallback.
-  bool stratified(int vertex) const { return vertex < kTabulatedVertices && !branch_; }
+  bool stratified(int vertex) const { return vertex < kTabulatedVertices && !branch_ && !hashedOnly_; }
   static uint32_t slotOf(int vertex, VertexDimension d) {
     return kFirstVertexSlot + uint32_t(vertex) * uint32_t(VertexDimension::Count) + uint32_t(d);
   }
@@ -113,9 +116,13 @@ class PixelSampler {
     p.x_ = sobol::toUnitFloat(sobol::scrambledVanDerCorput(p.index_, uint32_t(p.slotHash_ >> 32)));
     return p;
   }
-  float get1D(uint32_t slot) const { return independent_ ? independent_->uniform() : stratifiedPair(slot).x(); }
+  float get1D(uint32_t slot) const {
+    if (independent_) return independent_->uniform();
+    return hashedOnly_ ? hashedUniform(slot, 0) : stratifiedPair(slot).x();
+  }
   glm::vec2 get2D(uint32_t slot) const {
     if (independent_) return independent_->uniform2();
+    if (hashedOnly_) return {hashedUniform(slot, 0), hashedUniform(slot, 1)};
     Pair p = stratifiedPair(slot);
     return {p.x(), p.y()};
   }
@@ -129,6 +136,7 @@ class PixelSampler {
   uint64_t sampleKey_ = 0;  // hash of that and the whole index: the random fallback
   uint32_t reversedIndex_ = 0;  // the index's low 32 bits, bit-reversed
   bool branch_ = false;         // a split path's branch: hashed numbers at every vertex
+  bool hashedOnly_ = false;     // the random sampler: hashed numbers at every slot
   Rng* independent_ = nullptr;
 };
 

@@ -148,7 +148,7 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
     shaderFor = [](const PathTracer& t) { return pathTracerShader(t); };
   }
   std::optional<TileRenderer> renderer;
-  renderer.emplace(camera, settings.seed, shaderFor(*tracer));
+  renderer.emplace(camera, settings.seed, shaderFor(*tracer), settings.stratifiedSampler);
   Film film(settings.width, settings.height);
   // The auto rule: the film's first passes decide whether the window is used.
   const bool autoRoulette = settings.tracer.roulette == RouletteRule::Auto && settings.mode != SamplingMode::Preview;
@@ -191,7 +191,7 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
         result.windowFromPass = result.spp;
         renderer.reset();  // its shader holds the old tracer
         tracer = windowTracer();
-        renderer.emplace(camera, settings.seed, shaderFor(*tracer));
+        renderer.emplace(camera, settings.seed, shaderFor(*tracer), settings.stratifiedSampler);
       }
     }
     if (progress) progress(timed ? std::min(1.0, secondsSince(loaded) / settings.timeBudget) : double(pass + 1) / settings.spp);

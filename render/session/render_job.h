@@ -27,6 +27,9 @@ struct RenderJobSettings {
   PreviewSettings preview;  // VPLs, slices and clusters (preview and guided modes)
   GuideSettings guide;      // guided modes
   SkySettings sky;
+  // The camera paths' numbers: the stratified sampler (Owen-scrambled Sobol'), or independent random
+  // numbers at every slot (false; the paper's setting, an ablation).
+  bool stratifiedSampler = true;
 
   std::string validate() const;  // empty when valid
 };

@@ -23,8 +23,8 @@ ContinuationFactory guidedContinuations(const GuideField& guide, SamplingMode mo
   };
 }
 
-TileRenderer::TileRenderer(const Camera& camera, uint64_t seed, PixelShaderFactory shader)
-    : camera_(camera), seed_(seed), shader_(std::move(shader)),
+TileRenderer::TileRenderer(const Camera& camera, uint64_t seed, PixelShaderFactory shader, bool stratified)
+    : camera_(camera), seed_(seed), shader_(std::move(shader)), stratified_(stratified),
       tilesX_((camera.width() + kTileSize - 1) / kTileSize), tilesY_((camera.height() + kTileSize - 1) / kTileSize) {}
 
 PassStats TileRenderer::renderPass(Film& film, uint64_t pass, const std::atomic<bool>* stop) const {
@@ -40,7 +40,7 @@ PassStats TileRenderer::renderPass(Film& film, uint64_t pass, const std::atomic<
     for (int y = y0; y < y1; ++y)
       for (int x = x0; x < x1; ++x) {
         const uint64_t pixel = uint64_t(y) * uint64_t(width) + uint64_t(x);
-        PixelSampler sampler(seed_, pixel, pass);
+        PixelSampler sampler(seed_, pixel, pass, stratified_);
         const Ray ray = camera_.generateRay(glm::vec2(float(x), float(y)) + sampler.cameraJitter());
         const glm::vec3 L = shade(ray, pixel, sampler, path);
         ++stats.samples;

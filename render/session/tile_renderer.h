@@ -49,7 +49,8 @@ class TileRenderer {
  public:
   static constexpr int kTileSize = 16;
 
-  TileRenderer(const Camera& camera, uint64_t seed, PixelShaderFactory shader);
+  // `stratified` false: independent random numbers instead of the stratified sampler (PixelSampler).
+  TileRenderer(const Camera& camera, uint64_t seed, PixelShaderFactory shader, bool stratified = true);
 
   // Adds one sample per pixel to film. Stops early (between tiles) when *stop becomes true.
   PassStats renderPass(Film& film, uint64_t pass, const std::atomic<bool>* stop = nullptr) const;
@@ -63,6 +64,7 @@ class TileRenderer {
   Camera camera_;
   uint64_t seed_;
   PixelShaderFactory shader_;
+  bool stratified_;
   int tilesX_, tilesY_;
 };
 

@@ -373,6 +373,68 @@ TEST(PixelSampler, StratifiedEstimatesBeatIndependentOnes) {
   EXPECT_LT(se1, 0.01 * se1Random);
 }
 
+// The ablation `--sampler random`: every slot, the camera's too, gets independent uniform numbers, so
+// no pixel's first samples are stratified and a smooth integrand's error is that of an independent
+// stream, not the stratified sampler's hundredfold smaller one.
+TEST(PixelSampler, RandomSamplerIsIndependentUniformAtEverySlot) {
+  constexpr int kPixels = 64, kStrata = 4;  // 2^4 = 16 first samples per pixel
+  int stratifiedPixels[2][3] = {};
+  std::vector<float> camera, choice, direction;
+  std::vector<glm::vec2> lightPoints;
+  for (int p = 0; p < kPixels; ++p)
+    for (int mode = 0; mode < 2; ++mode) {
+      const bool stratified = mode == 1;
+      std::vector<float> c, l, d;
+      for (int k = 0; k < 512; ++k) {
+        PixelSampler sampler(3, uint64_t(p), uint64_t(k), stratified);
+        const float cx = sampler.cameraJitter().x, lx = sampler.get1D(0, VertexDimension::LightChoiceRoulette);
+        const glm::vec2 dir = sampler.get2D(2, VertexDimension::BsdfDirection);
+        if (k < (1 << kStrata)) {
+          c.push_back(cx);
+          l.push_back(lx);
+          d.push_back(dir.y);
+        }
+        if (!stratified) {
+          camera.push_back(cx);
+          choice.push_back(lx);
+          direction.push_back(dir.y);
+          lightPoints.push_back(sampler.get2D(0, VertexDimension::LightPoint));
+        }
+      }
+      stratifiedPixels[mode][0] += strataDefect(c, kStrata).empty();
+      stratifiedPixels[mode][1] += strataDefect(l, kStrata).empty();
+      stratifiedPixels[mode][2] += strataDefect(d, kStrata).empty();
+    }
+  for (int consumer = 0; consumer < 3; ++consumer) {
+    // Sixteen independent numbers fall one per stratum with probability 16!/16^16, about 1e-6.
+    EXPECT_EQ(stratifiedPixels[0][consumer], 0) << "consumer " << consumer;
+    EXPECT_EQ(stratifiedPixels[1][consumer], kPixels) << "consumer " << consumer;
+  }
+  EXPECT_GT(uniformChiSquareP(histogram1D(camera, 32)), kSignificance);
+  EXPECT_GT(uniformChiSquareP(histogram1D(choice, 32)), kSignificance);
+  EXPECT_GT(uniformChiSquareP(histogram1D(direction, 32)), kSignificance);
+  EXPECT_GT(uniformChiSquareP(histogram2D(lightPoints, 16)), kSignificance);
+
+  auto f = [](glm::vec2 u) { return double(std::exp(u.x) * std::sin(2.0f * u.y + 0.5f)); };
+  const double exact = (std::numbers::e - 1.0) * (std::cos(0.5) - std::cos(2.5)) / 2.0;
+  constexpr int kEstimates = 400, kN = 64;
+  double seHashed = 0, seIndependent = 0;
+  for (int p = 0; p < kEstimates; ++p) {
+    Rng rng = Rng::hashed(uint64_t(p) + 1000);
+    double hashed = 0, independent = 0;
+    for (int k = 0; k < kN; ++k) {
+      hashed += f(PixelSampler(11, uint64_t(p), uint64_t(k), false).get2D(1, VertexDimension::BsdfDirection));
+      independent += f(PixelSampler(rng).get2D(1, VertexDimension::BsdfDirection));
+    }
+    seHashed += std::pow(hashed / kN - exact, 2);
+    seIndependent += std::pow(independent / kN - exact, 2);
+  }
+  // Each sum averages 400 squared errors: their ratio stays within [0.7, 1.4] but for 1 in 10^3 or so.
+  std::printf("MSE ratio random sampler / independent stream at %d samples: %.3g\n", kN, seHashed / seIndependent);
+  EXPECT_GT(seHashed, 0.7 * seIndependent);
+  EXPECT_LT(seHashed, 1.4 * seIndependent);
+}
+
 TEST(PixelSampler, DeterministicInSeedPixelIndexAndIndependentOfCallOrder) {
   PixelSampler a(4, 77, 12), b(4, 77, 12);
   const float strategy = a.get1D(2, VertexDimension::StrategyGuideCell);
