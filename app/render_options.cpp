@@ -88,6 +88,10 @@ void RenderOptions::addCommonTo(CLI::App& command) {
   command.add_option("--joins", connections.joinsPerVertex,
                      "VPL connections: light vertices each camera vertex joins (one number, systematic over the choice)")
       ->check(CLI::Range(1, 16));
+  command.add_option("--join-roulette", connections.shadowRoulette,
+                     "VPL connections: a join worth less than this share of what its sample holds already traces "
+                     "its shadow ray with probability worth / (share x held) and weighs 1/that (0: every join traces)")
+      ->check(CLI::Range(0.0f, 100.0f));
   command.add_option("--sky", sky, "uniform sky radiance R,G,B; 0 turns it off (default: on only without lights)");
   command.add_option("--sampler", sampler,
                      "the camera paths' numbers: sobol (stratified: Owen-scrambled Sobol', one slot per decision) | "

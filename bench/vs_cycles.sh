@@ -21,7 +21,7 @@
 # CODE (how the tables name the code measured; default: the repository's commit).
 # The reference cache is keyed by the scene's bytes, not by vplview's code: delete OUT_DIR/ref_*.exr
 # when a change alters what the renderer converges to.
-# Needs Blender (apt-get install -y blender). A benchmark, not a test: run it on an idle machine.
+# Needs Blender (apt-get install -y blender python3-numpy). A benchmark, not a test: run it on an idle machine.
 set -euo pipefail
 build=$(cd "${1:?usage: vs_cycles.sh BUILD_DIR OUT_DIR [SECONDS...]}" && pwd)
 out=${2:?usage: vs_cycles.sh BUILD_DIR OUT_DIR [SECONDS...]}
@@ -33,7 +33,10 @@ cycles=${CYCLES_RENDER:-$here/../shared/tools/cycles/cycles-render}
 MODES=${MODES:-brdf mis}; THREADS=${THREADS:-2}; SEEDS=${SEEDS:-1 2}; MAX_DEPTH=${MAX_DEPTH:-32}; REF_THREADS=${REF_THREADS:-0}; REF_MODE=${REF_MODE:-brdf}
 [ -x "$exe" ] || { echo "vs_cycles: no $exe (cmake --build BUILD_DIR --target vplview)" >&2; exit 2; }
 [ -x "$cycles" ] || { echo "vs_cycles: no $cycles (set CYCLES_RENDER)" >&2; exit 2; }
-command -v blender >/dev/null || { echo "vs_cycles: Blender is missing: apt-get install -y blender" >&2; exit 2; }
+command -v blender >/dev/null || { echo "vs_cycles: Blender is missing: apt-get install -y blender python3-numpy" >&2; exit 2; }
+# Debian's blender runs the system Python, whose numpy the script imports but blender only recommends.
+dpkg-query -W -f='${Status}' python3-numpy 2>/dev/null | grep -q "install ok installed" ||
+  { echo "vs_cycles: Blender's Python has no numpy: apt-get install -y python3-numpy" >&2; exit 2; }
 for t in $budgets; do
   [[ $t =~ ^[0-9]+([.][0-9]+)?$ ]] || { echo "vs_cycles: '$t' is not a number of seconds" >&2; exit 2; }
 done
@@ -67,6 +70,7 @@ PY
 fi
 mv "$tmp_csv" "$csv"
 : > "$skipped.new"
+ran=$(mktemp)  # the scenes this run tried: their old entries in the skipped list are stale
 
 scenes=()
 for f in "$here"/scenes/*.gltf "$build"/scenes/*.glb; do [ -f "$f" ] && scenes+=("$f"); done
@@ -74,6 +78,7 @@ echo "$(date -Is) vs_cycles: budgets $budgets, seeds $SEEDS, threads $THREADS, m
 for scene in "${scenes[@]}"; do
   name=$(basename "${scene%.*}")
   if [ -n "${SCENES:-}" ] && [[ " $SCENES " != *" $name "* ]]; then continue; fi
+  echo "^$name:" >> "$ran"
   read -r W H < <(size_of "$name")
   bounces=$((MAX_DEPTH - 1))
   # Probe Cycles at 16 and 64 spp: refused scenes exit 2 here; the two times give the cost per spp and
@@ -124,7 +129,9 @@ print(p, max(a - 16 * p, 0.0))" "${probe[@]}")
 done
 rm -f "$out/probe.exr" "$out/probe.err"
 # Skipped scenes: keep earlier notes for scenes not probed in this run.
-if [ -f "$skipped" ]; then grep -v -F -f <(cut -d: -f1 "$skipped.new" | sed 's/$/:/') "$skipped" >> "$skipped.new" || true; fi
+if [ -f "$skipped" ] && [ -s "$ran" ]; then grep -v -f "$ran" "$skipped" >> "$skipped.new" || true
+elif [ -f "$skipped" ]; then cat "$skipped" >> "$skipped.new"; fi
+rm -f "$ran"
 sort -u "$skipped.new" > "$skipped"; rm -f "$skipped.new"
 
 if [ -z "${CODE:-}" ]; then

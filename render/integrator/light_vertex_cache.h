@@ -53,6 +53,14 @@ struct ConnectionSettings {
   // joins over 1 (3, 4): door_ajar 0.79 (0.74, 0.75), two_rooms 0.84 (0.86, 0.83), interior 0.81
   // (0.82, 0.83), Cornell box 0.94 (0.97, 1.03), cornell_glossy 1.03 (1.11, 1.20), 2 seeds for the last two.
   int joinsPerVertex = 2;
+  // Russian roulette on a join's shadow ray: a join whose contribution, were nothing in the way, is
+  // below this share of what its camera sample has brought back so far traces its ray only with
+  // probability contribution / (share x that value), at least kMinShadowSurvival, and weighs one
+  // over it. The probability is known before its number is drawn, so the estimate stays unbiased;
+  // the added variance is at most share^2 times the sample's value squared per join. 0: every join
+  // traces its ray.
+  float shadowRoulette = 0.0f;
+  static constexpr float kMinShadowSurvival = 0.05f;
 
   int pathsFor(int pixels, SamplingMode mode) const;
   std::string validate() const;
@@ -81,7 +89,7 @@ class LightVertexCache {
 
   explicit LightVertexCache(const ConnectionSettings& s)
       : learnChoice_(s.learnChoice), joinsPerVertex_(std::clamp(s.joinsPerVertex, 1, kMaxJoinsPerVertex)),
-        misFactor_(kCells, connectionMis(float(joinsPerVertex_))) {}
+        shadowRoulette_(std::max(0.0f, s.shadowRoulette)), misFactor_(kCells, connectionMis(float(joinsPerVertex_))) {}
 
   // Traces `paths` light paths of pass `pass`, each with numbers of its own hashed from (seed,
   // pass, path), and takes what the joins of the earlier passes recorded into the cells' choice: the
@@ -91,6 +99,7 @@ class LightVertexCache {
 
   bool empty() const { return vertices_.empty(); }
   int joinsPerVertex() const { return joinsPerVertex_; }
+  float shadowRoulette() const { return shadowRoulette_; }
   const std::vector<LightVertex>& vertices() const { return vertices_; }
   // The vertex for the number u in [0, 1); scale is one over its pick probability times the path
   // count (each camera vertex stands for one light path's worth of joins) and the joins per vertex.
@@ -154,6 +163,7 @@ class LightVertexCache {
 
   bool learnChoice_;
   int joinsPerVertex_;
+  float shadowRoulette_;
   std::vector<LightVertex> vertices_;  // grouped by cell
   // The non-empty cells: their first vertex, vertex count, pick probabilities (cumulative) and scale.
   std::vector<uint32_t> cellOf_, cellStart_, cellCount_;

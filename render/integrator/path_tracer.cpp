@@ -115,9 +115,9 @@ float PathTracer::nextEventWeight(const LightSample& ls, const SurfaceHit& surfa
   return bidirectionalWeight(wLight + wCamera);
 }
 
-glm::vec3 PathTracer::connect(const SurfaceHit& surface, const Bsdf& bsdf, const glm::vec3& wo, const Branch& path,
-                              ContinuationSampler& continuation, const LightVertex& y, float scale,
-                              PathStats& stats) const {
+glm::vec3 PathTracer::unoccludedJoin(const SurfaceHit& surface, const Bsdf& bsdf, const glm::vec3& wo, const Branch& path,
+                                     ContinuationSampler& continuation, const LightVertex& y, float scale,
+                                     Ray& shadow) const {
   if (path.depth + 1 + y.length > settings_.maxDepth) return glm::vec3(0.0f);
   const glm::vec3 d = y.position - surface.position;
   const float dist2 = glm::dot(d, d);
@@ -142,8 +142,7 @@ glm::vec3 PathTracer::connect(const SurfaceHit& surface, const Bsdf& bsdf, const
   // Over this join's own count (the other joins' counts are in the partial sums).
   const float weight = bidirectionalWeight((wLight + wCamera) / connections_->misFactor(y));
   if (!(weight > 0.0f)) return glm::vec3(0.0f);
-  ++stats.rays;
-  if (scene_.accel().occluded(spawnShadowRay(surface, w, dist))) return glm::vec3(0.0f);
+  shadow = spawnShadowRay(surface, w, dist);
   return camera.f * light.f * y.alpha * (cosLight / dist2 * scale * weight);
 }
 
@@ -252,7 +251,20 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
       // Joins to light vertices (the VPLs' share of the paths through here).
       for (int j = 0; j < joins; ++j) {
         const LightVertex& y = *joinTo[size_t(j)];
-        const glm::vec3 joined = beta * connect(surface, bsdf, wo, path, continuation, y, joinScale[size_t(j)], stats);
+        Ray shadow;
+        glm::vec3 joined = beta * unoccludedJoin(surface, bsdf, wo, path, continuation, y, joinScale[size_t(j)], shadow);
+        if (isBlack(joined)) continue;
+        // Shadow-ray roulette: a join worth little against what the sample holds already rarely pays its ray.
+        if (const float threshold = connections_->shadowRoulette() * luminance(L); threshold > 0.0f) {
+          const float c = luminance(joined);
+          if (c < threshold) {
+            const float survival = std::max(c / threshold, ConnectionSettings::kMinShadowSurvival);
+            if (u.random().uniform() >= survival) continue;
+            joined /= survival;
+          }
+        }
+        ++stats.rays;
+        if (scene_.accel().occluded(shadow)) continue;
         connections_->record(y, luminance(joined));
         L += joined;
       }

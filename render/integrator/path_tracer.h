@@ -119,9 +119,9 @@ class PathTracer {
   float nextEventWeight(const LightSample& ls, const SurfaceHit& surface, const Bsdf& bsdf, const glm::vec3& wo,
                         const Branch& path, ContinuationSampler& continuation) const;
   // The MIS-weighted contribution of joining camera vertex `surface` to light vertex y, picked with
-  // weight `scale` (without the path's throughput); 0 when y is too long, faces away or is occluded.
-  glm::vec3 connect(const SurfaceHit& surface, const Bsdf& bsdf, const glm::vec3& wo, const Branch& path,
-                    ContinuationSampler& continuation, const LightVertex& y, float scale, PathStats& stats) const;
+  // weight `scale` (without the path's throughput), if `shadow` arrives; 0 when y is too long or faces away.
+  glm::vec3 unoccludedJoin(const SurfaceHit& surface, const Bsdf& bsdf, const glm::vec3& wo, const Branch& path,
+                           ContinuationSampler& continuation, const LightVertex& y, float scale, Ray& shadow) const;
 
   const RenderScene& scene_;
   PathTracerSettings settings_;

@@ -45,10 +45,10 @@ class PixelSampler {
   // stream (benches, and as the baseline the stratified samples are measured against).
   explicit PixelSampler(Rng& rng) : independent_(&rng) {}
 
-  glm::vec2 cameraJitter() { return get2D(kCameraSlot); }
+  glm::vec2 cameraJitter() { return slot2D(kCameraSlot); }
   // The preview's two choices per pass: x, the offset of its systematic cluster picks; y, the slice
   // whose clusters it uses (its own or a neighbour, so that slices blend across their borders).
-  glm::vec2 previewChoices() { return get2D(kPreviewClusterSlot); }
+  glm::vec2 previewChoices() { return slot2D(kPreviewClusterSlot); }
 
   // A slot read in 1D is the first coordinate of its 2D point.
   float get1D(int vertex, VertexDimension d) {
@@ -116,13 +116,13 @@ class PixelSampler {
     p.x_ = sobol::toUnitFloat(sobol::scrambledVanDerCorput(p.index_, uint32_t(p.slotHash_ >> 32)));
     return p;
   }
-  float get1D(uint32_t slot) const {
-    if (independent_) return independent_->uniform();
-    return hashedOnly_ ? hashedUniform(slot, 0) : stratifiedPair(slot).x();
+  // A slot of its own outside the vertices' (which stratified() already sends to the fallback).
+  glm::vec2 slot2D(uint32_t slot) const {
+    return hashedOnly_ ? glm::vec2(hashedUniform(slot, 0), hashedUniform(slot, 1)) : get2D(slot);
   }
+  float get1D(uint32_t slot) const { return independent_ ? independent_->uniform() : stratifiedPair(slot).x(); }
   glm::vec2 get2D(uint32_t slot) const {
     if (independent_) return independent_->uniform2();
-    if (hashedOnly_) return {hashedUniform(slot, 0), hashedUniform(slot, 1)};
     Pair p = stratifiedPair(slot);
     return {p.x(), p.y()};
   }

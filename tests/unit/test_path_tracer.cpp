@@ -25,7 +25,7 @@ struct Rendered {
 // connectPaths > 0: VPL connections to that many light paths per pass.
 Rendered renderScene(const RenderScene& scene, int width, int height, int spp, uint64_t seed, int maxDepth = 64,
                      RouletteRule roulette = PathTracerSettings{}.roulette, int rrStart = PathTracerSettings{}.rrStartDepth,
-                     int connectPaths = 0, int joinsPerVertex = 1) {
+                     int connectPaths = 0, int joinsPerVertex = 1, float joinRoulette = 0.0f) {
   const Camera camera(defaultCamera(scene.data()), width, height);
   PathTracerSettings settings;
   settings.maxDepth = maxDepth;
@@ -33,7 +33,7 @@ Rendered renderScene(const RenderScene& scene, int width, int height, int spp, u
   settings.rrStartDepth = rrStart;
   IrradianceGrid irradiance;
   if (roulette == RouletteRule::Vpl) irradiance = IrradianceGrid(scene, 1 << 16, seed, maxDepth);
-  LightVertexCache connections(ConnectionSettings{.joinsPerVertex = joinsPerVertex});
+  LightVertexCache connections(ConnectionSettings{.joinsPerVertex = joinsPerVertex, .shadowRoulette = joinRoulette});
   const PathTracer tracer(scene, settings, &irradiance, connectPaths > 0 ? &connections : nullptr);
   const TileRenderer renderer(camera, seed, pathTracerShader(tracer));
   Film film(width, height);
@@ -112,6 +112,23 @@ TEST(WhiteFurnace, ConvergesWithVplConnections) {
       }
     }
   }
+}
+
+// Roulette on the joins' shadow rays: a share of 4 sends nearly every join through it (each is worth
+// less than 4 times what its sample holds), so a survivor that forgot to weigh 1/survival, or a
+// survival drawn from the number it is tested with, moves the answer. The rays it saves are counted.
+TEST(WhiteFurnace, ConvergesWithRouletteOnTheJoinsShadowRays) {
+  const float le = 0.5f, rho = 0.8f;
+  const RenderScene scene(test::furnaceScene(rho, le));
+  const Rendered all = renderScene(scene, 32, 32, 64, 11, 1024, RouletteRule::Sqrt, 5, 512, 2);
+  const Rendered some = renderScene(scene, 32, 32, 64, 11, 1024, RouletteRule::Sqrt, 5, 512, 2, 4.0f);
+  const double expected = le / (1.0 - rho);
+  for (int c = 0; c < 3; ++c) {
+    const MeanAndError m = channelMean(some.image, c);
+    EXPECT_NEAR(m.mean, expected, 4.0 * m.error + 1e-3 * expected) << "channel " << c;
+  }
+  EXPECT_EQ(some.stats.discarded, 0u);
+  EXPECT_LT(double(some.stats.rays), 0.9 * double(all.stats.rays)) << "the roulette traced nearly every join";
 }
 
 TEST(WhiteFurnace, GlossyMetalNeverGainsEnergy) {
