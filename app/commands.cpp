@@ -158,6 +158,7 @@ int runViewerCommand() {
   options.session.connections = s.connections;
   options.session.preview = s.preview;
   options.session.guide = s.guide;
+  options.session.stratifiedSampler = s.stratifiedSampler;
   options.sky = s.sky;
   options.windowWidth = gViewer.width;
   options.windowHeight = gViewer.height;

@@ -80,6 +80,7 @@ struct PanelSettings {
   int joinsPerVertex;  // ... this many per camera vertex
   bool learnGuides;   // guides learn from the paths between passes
   bool vplPrior;      // ... starting from the VPL guide (else from a uniform one)
+  bool stratifiedSampler;  // Owen-scrambled Sobol' (else independent random numbers: the paper's)
 };
 
 constexpr RouletteRule kRoulettes[] = {RouletteRule::Auto, RouletteRule::Sqrt, RouletteRule::Throughput, RouletteRule::Vpl};
@@ -145,7 +146,7 @@ int runViewer(const ViewerOptions& options) {
                         settings.guide.defensive,
                         settings.guide.uniformMutation, rouletteIndex(settings.tracer.roulette),
                         settings.connections.paths != 0, settings.connections.learnChoice, settings.connections.joinsPerVertex,
-                        settings.guide.learnDirections, settings.guide.vplPrior};
+                        settings.guide.learnDirections, settings.guide.vplPrior, settings.stratifiedSampler};
 
     Image image, variance;
     uint64_t version = 0;
@@ -252,6 +253,7 @@ int runViewer(const ViewerOptions& options) {
           ImGui::SliderInt("joins per camera vertex", &panel.joinsPerVertex, 1, LightVertexCache::kMaxJoinsPerVertex);
           ImGui::Checkbox("learn the guides from the paths", &panel.learnGuides);
           ImGui::Checkbox("start learning from the VPL guide", &panel.vplPrior);
+          ImGui::Checkbox("stratified sampler (else independent random numbers)", &panel.stratifiedSampler);
           if (ImGui::Button("apply (restarts)")) {
             SessionSettings next = settings;
             next.mode = stats.mode;
@@ -270,6 +272,7 @@ int runViewer(const ViewerOptions& options) {
             next.connections.joinsPerVertex = std::clamp(panel.joinsPerVertex, 1, LightVertexCache::kMaxJoinsPerVertex);
             next.guide.learnDirections = panel.learnGuides;
             next.guide.vplPrior = panel.vplPrior;
+            next.stratifiedSampler = panel.stratifiedSampler;
             session.reset();  // joins the old controller before the new one starts
             session = std::make_unique<ProgressiveSession>(scene, controller.camera(), next);
             settings = next;

@@ -212,7 +212,7 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
   if (!state.field) {
     const Camera small(request.camera, std::max(1, w / kQuickDivisor), std::max(1, h / kQuickDivisor));
     if (!state.quick) state.quick = std::make_unique<Film>(small.width(), small.height());
-    const TileRenderer renderer(small, settings_.seed, pathTracerShader(tracer_));
+    const TileRenderer renderer(small, settings_.seed, pathTracerShader(tracer_), settings_.stratifiedSampler);
     do {
       // The first quick pass always completes: a restart never leaves the window without a frame.
       const uint64_t pass = state.quickPasses++;
@@ -249,7 +249,8 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
       const VplField coarseField = buildVplField(scene, coarseCamera, vpls_, coarse, &cancel_);
       if (cancelled()) return;
       Film film(coarseCamera.width(), coarseCamera.height());
-      TileRenderer(coarseCamera, settings_.seed, previewShader(scene, coarseField, coarse)).renderPass(film, 0, &cancel_);
+      TileRenderer(coarseCamera, settings_.seed, previewShader(scene, coarseField, coarse), settings_.stratifiedSampler)
+          .renderPass(film, 0, &cancel_);
       if (cancelled()) return;
       publish(divisor > 1 ? upscaleNearest(film.resolve(), w, h) : film.resolve(), SessionStage::Coarse, 1);
       notePreview();
@@ -279,7 +280,7 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
   const auto previewStart = Clock::now();
   CameraState::ModeFilm& preview = state.preview;
   if (!preview.film) preview.film = std::make_unique<Film>(w, h);
-  const TileRenderer previewRenderer(camera, settings_.seed, previewShading);
+  const TileRenderer previewRenderer(camera, settings_.seed, previewShading, settings_.stratifiedSampler);
   auto modeFilmComplete = [&] {
     auto it = state.films.find(request.mode);
     return it == state.films.end() ? 0 : it->second.complete;
@@ -336,7 +337,7 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
     return *t;
   };
   std::optional<TileRenderer> renderer;
-  renderer.emplace(camera, settings_.seed, pathTracerShader(refineTracer(), continuation));
+  renderer.emplace(camera, settings_.seed, pathTracerShader(refineTracer(), continuation), settings_.stratifiedSampler);
   const auto noteWindow = [&] {
     std::lock_guard lock(mutex_);
     stats_.rouletteWindow = rule == RouletteRule::Vpl || (rule == RouletteRule::Auto && mine.window.on());
@@ -373,7 +374,7 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
     if (rule == RouletteRule::Auto && !mine.window.on() && WindowSwitch::updateDue(uint64_t(mine.complete)) &&
         mine.window.update(*mine.film)) {
       renderer.reset();
-      renderer.emplace(camera, settings_.seed, pathTracerShader(refineTracer(), continuation));
+      renderer.emplace(camera, settings_.seed, pathTracerShader(refineTracer(), continuation), settings_.stratifiedSampler);
       noteWindow();
     }
     if (mine.complete >= settings_.handoverSpp || preview.complete == 0)

@@ -43,6 +43,9 @@ struct SessionSettings {
   int maxSpp = 1 << 16;      // the controller idles after this many path-traced samples
   int maxSlices = 384;       // slices (cache points) per view at most; 0: preview.slices alone decides
   bool coarsePreview = true;  // show a coarse preview pass before the full clustering
+  // The camera paths' numbers: stratified (Owen-scrambled Sobol'), or independent random in every
+  // pass, quick, preview and refining alike (`--sampler random`, an ablation; RenderJobSettings's).
+  bool stratifiedSampler = true;
   PathTracerSettings tracer;
   ConnectionSettings connections;  // VPL connections of the refining passes
   PreviewSettings preview;

@@ -84,6 +84,25 @@ TEST(Session, RestartAfterACameraMoveEqualsAFreshRender) {
   }
 }
 
+// `--sampler random` reaches the viewer's passes: the refining film and the preview's both change,
+// and stay the same for the same seed.
+TEST(Session, RandomSamplerReachesTheRefiningAndThePreviewPasses) {
+  const auto scene = cornell();
+  const CameraData start = defaultCamera(scene->data());
+  for (SamplingMode mode : {SamplingMode::Brdf, SamplingMode::Mis, SamplingMode::Preview}) {
+    SessionSettings settings = small(mode, 4);
+    ProgressiveSession stratified(scene, start, settings);
+    const Image a = finalImage(stratified);
+    settings.stratifiedSampler = false;
+    ProgressiveSession random(scene, start, settings), again(scene, start, settings);
+    const Image b = finalImage(random), c = finalImage(again);
+    ASSERT_EQ(a.pixels.size(), b.pixels.size());
+    EXPECT_GT(relMse(b, a), 0.0) << modeName(mode) << ": the sampler setting changed no number";
+    EXPECT_EQ(relMse(c, b), 0.0) << modeName(mode);
+    EXPECT_EQ(random.stats().stage, SessionStage::Done) << modeName(mode);
+  }
+}
+
 TEST(Session, MovesDuringEveryStageStillEndInTheFreshImage) {
   // Camera moves that land in the quick stage, the (cancelled) clustering, the preview and the
   // refinement: whatever was cut short, the last view's image is the fresh render's.
