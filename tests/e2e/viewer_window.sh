@@ -36,7 +36,9 @@ for after in 3 12 40; do
   echo "the window still showed the $stage stage after $after s: waiting longer"
 done
 [ "$stage" != quick ] && [ "$stage" != coarse ] || { echo "FAIL: the window never got past the $stage stage"; exit 1; }
-"$exe" capture "$scene" --mode brdf --spp 256 --width 320 --height 240 --out "$tmp/capture.png" >/dev/null || exit 1
+# 64 spp: against 256 the mean differs by 0.0 % and the worst block by 0.7 %, far inside the bounds, at a
+# quarter of the time (56 s against 15 s under AddressSanitizer, where this is on the CI run's critical path).
+"$exe" capture "$scene" --mode brdf --spp 64 --width 320 --height 240 --out "$tmp/capture.png" >/dev/null || exit 1
 compare=$repo/tests/e2e/png_compare.py
 python3 "$compare" "$tmp/window.png" "$tmp/capture.png" 0.05 0.20 10 || exit 1
 for scale in 0.9 1.1; do
