@@ -255,8 +255,8 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
         glm::vec3 joined = beta * unoccludedJoin(surface, bsdf, wo, path, continuation, y, joinScale[size_t(j)], shadow);
         if (isBlack(joined)) continue;
         // Shadow-ray roulette: a join worth little against what the sample holds already rarely pays its ray.
-        if (const float threshold = connections_->shadowRoulette() * luminance(L); threshold > 0.0f) {
-          const float c = luminance(joined);
+        if (const float share = connections_->shadowRoulette(); share > 0.0f) {
+          const float c = luminance(joined), threshold = share * luminance(L);
           if (c < threshold) {
             const float survival = std::max(c / threshold, ConnectionSettings::kMinShadowSurvival);
             if (u.random().uniform() >= survival) continue;
