@@ -57,7 +57,7 @@ class PixelSampler {
   }
   glm::vec2 get2D(int vertex, VertexDimension d) {
     const uint32_t slot = slotOf(vertex, d);
-    return stratified(vertex) || independent_ ? get2D(slot) : glm::vec2(hashedUniform(slot, 0), hashedUniform(slot, 1));
+    return stratified(vertex) || independent_ ? get2D(slot) : hashed2D(slot);
   }
   // A slot shared by two decisions of which most vertices read only the first (light choice and
   // roulette, joins and guide cell): its second coordinate is computed when asked, the same number
@@ -118,7 +118,7 @@ class PixelSampler {
   }
   // A slot of its own outside the vertices' (which stratified() already sends to the fallback).
   glm::vec2 slot2D(uint32_t slot) const {
-    return hashedOnly_ ? glm::vec2(hashedUniform(slot, 0), hashedUniform(slot, 1)) : get2D(slot);
+    return hashedOnly_ ? hashed2D(slot) : get2D(slot);
   }
   float get1D(uint32_t slot) const { return independent_ ? independent_->uniform() : stratifiedPair(slot).x(); }
   glm::vec2 get2D(uint32_t slot) const {
@@ -131,6 +131,7 @@ class PixelSampler {
   float hashedUniform(uint32_t slot, uint32_t component) const {
     return float(mix64(sampleKey_ + 2u * uint64_t(slot) + component) >> 40) * 0x1p-24f;
   }
+  glm::vec2 hashed2D(uint32_t slot) const { return {hashedUniform(slot, 0), hashedUniform(slot, 1)}; }
 
   uint64_t pixelKey_ = 0;   // hash of (seed, pixel, the index's high half): the slots' scrambles
   uint64_t sampleKey_ = 0;  // hash of that and the whole index: the random fallback
