@@ -122,8 +122,8 @@ void RenderOptions::addCommonTo(CLI::App& command) {
   command.add_option("--perturb", perturbDegrees, "Metropolis perturbation cone, degrees")->check(CLI::Range(0.01f, 180.0f));
   command.add_option("--mutations", guide.mutations, "Metropolis steps per direction")->check(CLI::Range(1, 1000));
   command.add_option("--bsdf-prob", bsdfProb,
-                     "mis: probability of sampling the BSDF, P in [0, 1] everywhere (default 0.5, the paper's), or auto: "
-                     "each cache point learns its own from the paths, starting at 0.5")
+                     "mis: probability of sampling the BSDF: auto (default): each cache point learns its own from the "
+                     "paths, starting at 0.5 | P in [0, 1] everywhere (the paper's: 0.5)")
       ->check([](const std::string& v) -> std::string {
         if (v == "auto") return {};
         try {

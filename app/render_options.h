@@ -16,7 +16,7 @@ struct RenderOptions {
   int threads = 0;  // 0 = all cores
   std::string roulette = "auto";
   std::string sampler = "sobol";
-  std::string bsdfProb = "0.5";  // mis: a fixed probability, or "auto" (learned per cache point)
+  std::string bsdfProb = "auto";  // mis: a fixed probability, or "auto" (learned per cache point)
   std::string misGuide = "exact";  // mis: exact stratified guide samples, or the Metropolis chain  // mis: "auto" (learned per cache point) or a fixed probability
   PathTracerSettings tracer;  // depth, roulette start and the weight window's flags (the rule: `roulette`)
   ConnectionSettings connections;  // --connect-paths

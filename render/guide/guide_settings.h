@@ -9,9 +9,10 @@
 //   mutations          int    1      Markov chain steps per requested direction
 //   bsdfProbability    float  0.5    one-sample MIS: probability of sampling the BSDF instead of the guide (with
 //                                    learnSelection: the prior of every cache point, until it has samples)
-//   learnSelection     bool   false  mis: each cache point learns its probability from the paths between passes
-//                                    (selection_learner.h). Measured at 10 s (2 seeds): 1.04-1.08x the relMSE of a
-//                                    fixed 0.5 on the Cornell box, 0.99-1.02x on two_rooms; off by default
+//   learnSelection     bool   true   mis: each cache point learns its probability from the paths between passes
+//                                    (selection_learner.h). Measured at 10 s against a fixed 0.5 (2 seeds): relMSE
+//                                    0.88x on cornell_glossy, 0.96x on the Cornell box, 0.99x on door_ajar and
+//                                    two_rooms, 1.04x on the interior (false: the paper's fixed probability)
 //   learnDirections    bool   true   each cache point's guide learns from what the paths bring back between passes,
 //                                    with the VPL guide as its prior (guide_learner.h; off: Hua & Low's guide).
 //                                    Measured at 48 spp (seeds 2, 3): relMSE 0.97-0.98x on the Cornell box, 0.92-0.97x
@@ -43,7 +44,7 @@ struct GuideSettings {
   float perturbationAngle = 0.157f;
   int mutations = 1;
   float bsdfProbability = 0.5f;
-  bool learnSelection = false;
+  bool learnSelection = true;
   bool learnDirections = true;
   bool vplPrior = true;
   bool misChain = false;

@@ -44,6 +44,12 @@ void SelectionLearner::update() {
     size_t best = 0;
     for (size_t k = 1; k < kCount; ++k)
       if (moment_[c][k] < moment_[c][best]) best = k;
+    // The most BSDF whose moment is within the margin of the least (see kStratifiedMargin).
+    for (size_t k = kCount - 1; k > best; --k)
+      if (moment_[c][k] <= (1.0 + kStratifiedMargin) * moment_[c][best]) {
+        best = k;
+        break;
+      }
     if (std::isfinite(moment_[c][best])) probability_[c] = kCandidates[best];
   }
 }
