@@ -31,7 +31,8 @@ for name in $SCENES; do
   for seed in $SEEDS; do
     for mode in brdf metropolis mis; do
       img=$out/${name}_${mode}_seed$seed.exr
-      read -r secs < <("$exe" render "$scene" --mode $mode --spp "$spp" --width $W --height $H --threads $THREADS \
+      paper=; [ $mode = mis ] && paper="--bsdf-prob 0.5"  # the authors' fixed BSDF probability, not the learned one
+      read -r secs < <("$exe" render "$scene" --mode $mode $paper --spp "$spp" --width $W --height $H --threads $THREADS \
                           --seed $seed --max-depth 2 $rule --out "$img" | json seconds)
       rel=$("$exe" compare "$img" "$ref" | json relmse)
       echo "$name,$mode,$seed,$spp,$secs,$rel" | tee -a /dev/stderr >> "$csv"
