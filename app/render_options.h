@@ -16,8 +16,8 @@ struct RenderOptions {
   int threads = 0;  // 0 = all cores
   std::string roulette = "auto";
   std::string sampler = "sobol";
-  std::string bsdfProb = "auto";  // mis: a fixed probability, or "auto" (learned per cache point)
-  std::string misGuide = "exact";  // mis: exact stratified guide samples, or the Metropolis chain  // mis: "auto" (learned per cache point) or a fixed probability
+  std::string bsdfProb = "auto";  // mis: "auto" (learned per cache point) or a fixed probability
+  std::string misGuide = "exact";  // mis: exact stratified guide samples, or the Metropolis chain
   PathTracerSettings tracer;  // depth, roulette start and the weight window's flags (the rule: `roulette`)
   ConnectionSettings connections;  // --connect-paths
   std::string out, png;

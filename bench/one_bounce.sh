@@ -2,6 +2,7 @@
 # The authors' setting (Hua & Low 2015, their Figure 1): one-bounce indirect light (--max-depth 2),
 # equal spp, relMSE of `brdf`, `metropolis` and `mis` against a converged `brdf` reference of the same
 # depth. Their claim: MIS has the lowest error of the three. Issue 16 keeps it as an ablation row.
+# mis runs with their fixed BSDF probability (--bsdf-prob 0.5), not the learned default.
 #
 #   bench/one_bounce.sh BUILD_DIR OUT_DIR [SPP]        (default 64)
 #

@@ -9,7 +9,8 @@
 // drawn with, and what the rest of its path brought back (the continuation's estimate F / q). From
 // those samples alone, the second moment of the estimator under every candidate mixture q_a is
 // estimated by re-weighting: E_{q_a}[(F/q_a)^2] = E_q[(F/q)^2 q / q_a]. Between passes, each
-// cache point with enough samples takes the candidate with the least; the others keep the prior.
+// cache point with enough samples takes the least, or more BSDF within a margin of it (below); the
+// others keep the prior. Where every path brought nothing back, every moment is 0 and the BSDF wins.
 // A probability stays fixed during a pass and depends only on earlier passes, so each pass is still
 // an unbiased estimate, with both densities exact.
 //

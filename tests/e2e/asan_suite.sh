@@ -26,7 +26,7 @@ export LSAN_OPTIONS="suppressions=$repo/tests/sanitizers/lsan.supp:print_suppres
 skip="asan_suite|tsan_session|fuzz_loader|gltf_validator"
 skip+="|Preview\\.(PassesLeaveNoSteps|CoarseFirstPreview|SumsThePaths|PixelChoice|FirstPassesConverge)"
 skip+="|ScalingTheSceneLeavesThePreviewsDistributionUnchanged"
-skip+="|CyclesAnchor|PixelByPixel/two_rooms_(mis|metropolis|mixture|mis_chain|mis_learned|mis_every_vertex)( |\$)"
+skip+="|CyclesAnchor|PixelByPixel/two_rooms_(mis|metropolis|mixture|mis_chain|mis_fixed_probability|mis_every_vertex)( |\$)"
 skip+="|PixelByPixel/door_ajar_brdf_connections"  # cornell_glossy_brdf_vpl_roulette_connections: brdf's joins
 # The random sampler's convergence (2 x 1024 spp): its code runs here in PixelSampler's own tests.
 skip+="|RenderJob\\.RandomSamplerConvergesToTheStratifiedImage"

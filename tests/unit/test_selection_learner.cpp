@@ -72,6 +72,17 @@ TEST(SelectionLearner, TakesTheMostBsdfWithinTheMarginOfTheLeastMoment) {
   EXPECT_EQ(learnedFrom(64, 64), 0.75f);
   // nQ = 5 nP: 1.42, 1.48, 1.60, 1.83, 2.20 (per nQ): the least at 0.1, 0.3 is 5 % above, 0.5 13 %.
   EXPECT_EQ(learnedFrom(13, 65), 0.3f);
+  // nQ = 3 nP: 1.66, 1.69, 1.78, 1.98, 2.33 (per nQ): the least at 0.1, 0.3 is 2 % above, 0.5 7 %: the
+  // most BSDF within the margin, not one step towards it.
+  EXPECT_EQ(learnedFrom(8, 24), 0.5f);
+}
+
+TEST(SelectionLearner, TakesTheBsdfWherePathsBroughtNothingBack) {
+  // Every moment is 0: nothing speaks for the guide, and the BSDF's samples are the stratified ones.
+  SelectionLearner learner(1, 1, 0.5f);
+  for (uint32_t i = 0; i < SelectionLearner::kMinSamples; ++i) learner.tileLog(0).add(0, 1.0f, 0.5f, 1.0f, 0.0f);
+  learner.update();
+  EXPECT_EQ(learner.bsdfProbability(0), 1.0f);
 }
 
 TEST(SelectionLearner, KeepsThePriorUntilACachePointHasEnoughSamples) {
