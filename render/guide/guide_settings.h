@@ -10,10 +10,8 @@
 //   bsdfProbability    float  0.5    one-sample MIS: probability of sampling the BSDF instead of the guide (with
 //                                    learnSelection: the prior of every cache point, until it has samples)
 //   learnSelection     bool   true   mis: each cache point learns its probability from the paths between passes
-//                                    (selection_learner.h). Measured at 10 s against a fixed 0.5, two runs of 2 seeds:
-//                                    relMSE 0.88-0.89x on cornell_glossy, 0.96-0.99x on the Cornell box, 0.99x on
-//                                    two_rooms, 0.99-1.03x on door_ajar, 1.01-1.04x on the interior (false: the
-//                                    paper's fixed probability)
+//                                    (selection_learner.h, measured in the README's "The learned BSDF
+//                                    probability"); false: the paper's fixed probability
 //   learnDirections    bool   true   each cache point's guide learns from what the paths bring back between passes,
 //                                    with the VPL guide as its prior (guide_learner.h; off: Hua & Low's guide).
 //                                    Measured at 48 spp (seeds 2, 3): relMSE 0.97-0.98x on the Cornell box, 0.92-0.97x
