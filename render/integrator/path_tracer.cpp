@@ -237,7 +237,7 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
       }
 
       // Next-event estimation: one light sample, MIS with the continuation strategy.
-      if (const auto ls = emitters.sample(surface.position, u.lightChoice(), u.lightPoint())) {
+      if (const auto ls = emitters.sampleStratified(surface.position, u.lightPoint(), u.lightChoice())) {
         const glm::vec3 f = glm::dot(ls->wi, surface.geometricNormal) > 0.0f ? bsdf.eval(wo, ls->wi) : glm::vec3(0.0f);
         if (!isBlack(f)) {
           ++stats.rays;

@@ -24,7 +24,7 @@ namespace vpl {
 enum class VertexDimension : uint32_t {
   LightPoint,           // the point on the chosen emitter (next-event estimation)
   BsdfDirection,        // the BSDF's direction; x also picks its lobe (Bsdf::sample(wo, u))
-  LightChoiceRoulette,  // x: which emitter; y: Russian roulette
+  LightChoiceRoulette,  // x: which emitter, where too many to fold into LightPoint's x (EmitterSet::sampleStratified); y: Russian roulette
   StrategyGuideCell,    // x: the light vertices a vertex joins, or a free strategy where none are (mis takes its strategy from BsdfDirection's x); y: the guide's cell or its defensive share
   GuidePoint,           // the point within the guide's cell
   Count

@@ -173,6 +173,18 @@ std::optional<LightSample> EmitterSet::sample(const glm::vec3& p, float uLight, 
   if (distribution_.empty()) return std::nullopt;
   float pmf = 0.0f;
   const size_t index = distribution_.sample(uLight, &pmf);
+  return sampleChosen(p, index, pmf, u);
+}
+
+std::optional<LightSample> EmitterSet::sampleStratified(const glm::vec3& p, glm::vec2 u, float uSpare) const {
+  if (distribution_.size() > kMaxFoldedChoices) return sample(p, uSpare, u);
+  if (distribution_.empty()) return std::nullopt;
+  float pmf = 0.0f;
+  const size_t index = distribution_.sample(u.x, &pmf, &u.x);
+  return sampleChosen(p, index, pmf, u);
+}
+
+std::optional<LightSample> EmitterSet::sampleChosen(const glm::vec3& p, size_t index, float pmf, glm::vec2 u) const {
   LightSample s;
   if (index < triangles_.size()) {
     const TriangleLight& light = triangles_[index];
