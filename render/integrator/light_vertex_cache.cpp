@@ -30,10 +30,10 @@ struct PathVertices {
   uint64_t rays = 0;
 };
 
-void traceLightSubpath(const RenderScene& scene, const LightVertexCache& cache, uint64_t key, int maxLength,
+template <class Numbers>
+void traceLightSubpath(const RenderScene& scene, const LightVertexCache& cache, Numbers& numbers, int maxLength,
                        PathVertices& out) {
-  Rng rng = Rng::hashed(key);
-  const auto e = startLightPath(scene, rng);
+  const auto e = startLightPath(scene, numbers);
   if (!e) return;
   // A light that no ray can hit (a point, a direction) has no strategy that reaches its start by
   // BSDF sampling: dVC starts at 0.
@@ -56,7 +56,7 @@ void traceLightSubpath(const RenderScene& scene, const LightVertexCache& cache, 
     dVC = connectionMis(cosOut / s.pdf) * (dVC * connectionMis(v.bsdf.pdf(s.wi, v.wIn)) + dVCM);
     dVCM = connectionMis(1.0f / s.pdf) * cache.misFactor(v.surface.position);  // a join with its light end here
   };
-  out.rays += walkLightPath(scene, rng, *e, maxLength, onVertex, onScatter);
+  out.rays += walkLightPath(scene, numbers, *e, maxLength, onVertex, onScatter);
 }
 
 }  // namespace
@@ -81,7 +81,8 @@ void LightVertexCache::learnFromLastPass() {
   }
 }
 
-void LightVertexCache::build(const RenderScene& scene, uint64_t seed, uint64_t pass, int paths, int maxLength) {
+void LightVertexCache::build(const RenderScene& scene, uint64_t seed, uint64_t pass, int paths, int maxLength,
+                             bool stratified) {
   low_ = scene.data().boundsMin;
   perUnit_ = float(kCellsPerAxis) / glm::max(scene.data().boundsMax - low_, glm::vec3(1e-20f));
   learnFromLastPass();
@@ -100,10 +101,21 @@ void LightVertexCache::build(const RenderScene& scene, uint64_t seed, uint64_t p
   const int batches = (paths + kBatch - 1) / kBatch;
   std::vector<PathVertices> results(static_cast<size_t>(batches));
   const uint64_t passKey = mix64(mix64(seed ^ 0x6c76635f70617468ull) ^ pass);
+  // The pass's paths are the samples of one stream of PixelSampler's (an index no pixel has).
+  constexpr uint64_t kLightPathStream = ~uint64_t(0);
   // Batches in parallel, appended in path order: the cache is the same for any thread count.
   tbb::parallel_for(0, batches, [&](int b) {
     const int end = std::min(paths, (b + 1) * kBatch);
-    for (int i = b * kBatch; i < end; ++i) traceLightSubpath(scene, *this, mix64(passKey ^ uint64_t(i)), maxLength, results[size_t(b)]);
+    for (int i = b * kBatch; i < end; ++i) {
+      if (stratified) {
+        StratifiedWalkNumbers numbers{PixelSampler(passKey, kLightPathStream, uint64_t(i))};
+        traceLightSubpath(scene, *this, numbers, maxLength, results[size_t(b)]);
+      } else {
+        Rng rng = Rng::hashed(mix64(passKey ^ uint64_t(i)));
+        RandomWalkNumbers numbers{rng};
+        traceLightSubpath(scene, *this, numbers, maxLength, results[size_t(b)]);
+      }
+    }
   });
   std::vector<std::vector<LightVertex>> batchVertices;
   batchVertices.reserve(results.size());

@@ -91,11 +91,13 @@ class LightVertexCache {
       : learnChoice_(s.learnChoice), joinsPerVertex_(std::clamp(s.joinsPerVertex, 1, kMaxJoinsPerVertex)),
         shadowRoulette_(std::max(0.0f, s.shadowRoulette)), misFactor_(kCells, connectionMis(float(joinsPerVertex_))) {}
 
-  // Traces `paths` light paths of pass `pass`, each with numbers of its own hashed from (seed,
-  // pass, path), and takes what the joins of the earlier passes recorded into the cells' choice: the
-  // cache depends on nothing else (not threads). Subpaths end after maxLength segments or by Russian
+  // Traces `paths` light paths of pass `pass` and takes what the joins of the earlier passes
+  // recorded into the cells' choice: the cache depends on nothing else (not threads). Path i of a
+  // pass takes the i-th point of the pass's scrambled Sobol sequences (`stratified`: its start, the
+  // emitter folded into the position's x, and its first scatterings; render/vpl/light_walk.h) or
+  // numbers hashed from (seed, pass, path). Subpaths end after maxLength segments or by Russian
   // roulette. Empty for lights that connections do not support.
-  void build(const RenderScene& scene, uint64_t seed, uint64_t pass, int paths, int maxLength);
+  void build(const RenderScene& scene, uint64_t seed, uint64_t pass, int paths, int maxLength, bool stratified = true);
 
   bool empty() const { return vertices_.empty(); }
   int joinsPerVertex() const { return joinsPerVertex_; }

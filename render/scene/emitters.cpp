@@ -336,6 +336,19 @@ std::optional<EmissionSample> EmitterSet::sampleEmission(float uLight, glm::vec2
   if (distribution_.empty()) return std::nullopt;
   float pmf = 0.0f, uSide = 0.0f;
   const size_t index = distribution_.sample(uLight, &pmf, &uSide);
+  return sampleEmissionChosen(index, pmf, uSide, uPos, uDir);
+}
+
+std::optional<EmissionSample> EmitterSet::sampleEmissionStratified(glm::vec2 uPos, glm::vec2 uDir, float uSpare) const {
+  if (distribution_.size() > kMaxFoldedChoices) return sampleEmission(uSpare, uPos, uDir);
+  if (distribution_.empty()) return std::nullopt;
+  float pmf = 0.0f;
+  const size_t index = distribution_.sample(uPos.x, &pmf, &uPos.x);
+  return sampleEmissionChosen(index, pmf, uSpare, uPos, uDir);
+}
+
+std::optional<EmissionSample> EmitterSet::sampleEmissionChosen(size_t index, float pmf, float uSide, glm::vec2 uPos,
+                                                               glm::vec2 uDir) const {
   EmissionSample e;
   if (index < triangles_.size()) {
     // Position uniform on the triangle, direction cosine-distributed: weight = Le pi area / pmf.

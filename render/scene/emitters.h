@@ -69,6 +69,9 @@ class EmitterSet {
 
   // Starting vertex of a light path, for VPL tracing.
   std::optional<EmissionSample> sampleEmission(float uLight, glm::vec2 uPos, glm::vec2 uDir) const;
+  // The same with the emitter's choice folded into uPos.x, as sampleStratified() folds it; uSpare
+  // picks the side of a two-sided emitter, and the emitter too past kMaxFoldedChoices.
+  std::optional<EmissionSample> sampleEmissionStratified(glm::vec2 uPos, glm::vec2 uDir, float uSpare) const;
   // Density with which sampleEmission() starts at the emitting point of a hit and leaves along
   // `direction` (area x solid angle, light choice included): the light-tracing side of a camera
   // path's emitter hit in bidirectional MIS.
@@ -117,6 +120,8 @@ class EmitterSet {
   TrianglePoint trianglePoint(const TriangleLight& light, glm::vec2 barycentric) const;
   // The spherical triangle of `light` seen from p when sample() samples it by solid angle from
   // there; nullopt when it samples by area.
+  // sampleEmission() once the emitter `index` is chosen with probability pmf.
+  std::optional<EmissionSample> sampleEmissionChosen(size_t index, float pmf, float uSide, glm::vec2 uPos, glm::vec2 uDir) const;
   // sample() once the emitter `index` is chosen with probability pmf.
   std::optional<LightSample> sampleChosen(const glm::vec3& p, size_t index, float pmf, glm::vec2 u) const;
   static std::optional<SphericalTriangle> solidAngleStrategy(const glm::vec3& p, const TriangleLight& light);

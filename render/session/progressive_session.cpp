@@ -352,7 +352,8 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
   }
   while (mine.complete < settings_.maxSpp) {
     const auto t = Clock::now();
-    if (joinPaths > 0) mine.joins->build(scene, settings_.seed, mine.nextPass, joinPaths, settings_.tracer.maxDepth - 1);
+    if (joinPaths > 0) mine.joins->build(scene, settings_.seed, mine.nextPass, joinPaths, settings_.tracer.maxDepth - 1,
+                                      settings_.stratifiedSampler);
     const PassStats pass = renderer->renderPass(*mine.film, mine.nextPass++, &cancel_);
     state.renderSeconds += secondsSince(t);
     state.samples += pass.samples;

@@ -164,7 +164,7 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
     if (timed && pass > 0 && stop.load()) break;
     if (connecting) {
       const auto t = Clock::now();
-      connectionCache.build(scene, settings.seed, pass, connectionPaths, settings.tracer.maxDepth - 1);
+      connectionCache.build(scene, settings.seed, pass, connectionPaths, settings.tracer.maxDepth - 1, settings.stratifiedSampler);
       result.timings.connections += secondsSince(t);
       result.rays += connectionCache.rays();
     }

@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <optional>
 #include "render/core/color.h"
+#include "render/sampling/pixel_sampler.h"
 #include "render/sampling/rng.h"
 #include "render/scene/render_scene.h"
 
@@ -26,11 +27,34 @@ struct LightWalkVertex {
   int length;                  // segments from the emitter, 1 at the first surface
 };
 
-// The path's start from four numbers of `rng`; empty when the emitters send nothing.
-inline std::optional<EmissionSample> startLightPath(const RenderScene& scene, Rng& rng) {
-  const float uLight = rng.uniform();
-  const glm::vec2 uPos = rng.uniform2(), uDir = rng.uniform2();
-  auto e = scene.emitters().sampleEmission(uLight, uPos, uDir);
+// Where a walk's numbers come from: RandomWalkNumbers draws each from one random stream, in the
+// order the walk asks; StratifiedWalkNumbers gives path i of a batch the i-th point of an
+// Owen-scrambled Sobol sequence in every decision (PixelSampler's slots, the path index as the
+// sample index), so that a batch's paths spread over the emitters and their directions as a
+// pixel's samples spread over the pixel.
+struct RandomWalkNumbers {
+  Rng& rng;
+  float choice() { return rng.uniform(); }
+  glm::vec2 position() { return rng.uniform2(); }
+  glm::vec2 direction() { return rng.uniform2(); }
+  glm::vec2 scatter(int) { return rng.uniform2(); }
+  float roulette(int) { return rng.uniform(); }
+};
+struct StratifiedWalkNumbers {
+  PixelSampler sampler;  // vertex 0: the start; vertex k: the scattering at the k-th surface
+  float choice() { return sampler.get1D(0, VertexDimension::LightChoiceRoulette); }
+  glm::vec2 position() { return sampler.get2D(0, VertexDimension::LightPoint); }
+  glm::vec2 direction() { return sampler.get2D(0, VertexDimension::BsdfDirection); }
+  glm::vec2 scatter(int length) { return sampler.get2D(length, VertexDimension::BsdfDirection); }
+  float roulette(int length) { return sampler.getPair(length, VertexDimension::LightChoiceRoulette).y(); }
+};
+
+// The path's start; empty when the emitters send nothing.
+template <class Numbers>
+std::optional<EmissionSample> startLightPath(const RenderScene& scene, Numbers& numbers) {
+  const float uLight = numbers.choice();
+  const glm::vec2 uPos = numbers.position(), uDir = numbers.direction();
+  auto e = scene.emitters().sampleEmissionStratified(uPos, uDir, uLight);
   if (!e || !(e->pdf > 0.0f) || !isFiniteNonNegative(e->weight) || isBlack(e->weight)) return std::nullopt;
   return e;
 }
@@ -39,8 +63,8 @@ inline std::optional<EmissionSample> startLightPath(const RenderScene& scene, Rn
 // every surface reached and returns false to end the walk there; onScatter(const LightWalkVertex&,
 // const BsdfSample&, float cosOut) at every vertex the walk leaves, before roulette (cosOut: the
 // sampled direction's cosine to the geometric normal). Returns the rays traced.
-template <class OnVertex, class OnScatter>
-uint64_t walkLightPath(const RenderScene& scene, Rng& rng, const EmissionSample& start, int maxLength,
+template <class Numbers, class OnVertex, class OnScatter>
+uint64_t walkLightPath(const RenderScene& scene, Numbers& numbers, const EmissionSample& start, int maxLength,
                        OnVertex&& onVertex, OnScatter&& onScatter) {
   uint64_t rays = 0;
   glm::vec3 throughput = start.weight;
@@ -61,7 +85,7 @@ uint64_t walkLightPath(const RenderScene& scene, Rng& rng, const EmissionSample&
     const LightWalkVertex vertex{surface, bsdf, wIn, throughput, hit.t, length};
     if (!onVertex(vertex) || length == maxLength) break;
 
-    const auto s = bsdf.sample(wIn, rng.uniform2());
+    const auto s = bsdf.sample(wIn, numbers.scatter(length));
     if (!s || !(s->pdf > 0.0f)) break;
     const float cosOut = glm::dot(surface.geometricNormal, s->wi);
     if (!(cosOut > 0.0f)) break;
@@ -70,7 +94,7 @@ uint64_t walkLightPath(const RenderScene& scene, Rng& rng, const EmissionSample&
     onScatter(vertex, *s, cosOut);
     throughput *= s->weight * (nsIn * cosOut / (nsOut * cosIn));
     const float survive = std::min(1.0f, maxComponent(throughput) / std::max(1e-30f, startMax));
-    if (rng.uniform() >= survive) break;
+    if (numbers.roulette(length) >= survive) break;
     throughput /= survive;
     if (!isFiniteNonNegative(throughput)) break;
     ray = spawnRay(surface, s->wi);

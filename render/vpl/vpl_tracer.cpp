@@ -25,7 +25,8 @@ struct PathResult {
 void traceLightPath(const RenderScene& scene, const VplSettings& settings, uint64_t pathIndex, PathResult& out) {
   // A light path takes an unbounded count of numbers: its own hashed random stream.
   Rng rng = Rng::hashed(mix64(settings.seed ^ 0x5bd1e995ull) ^ pathIndex);
-  const auto emission = startLightPath(scene, rng);
+  RandomWalkNumbers numbers{rng};
+  const auto emission = startLightPath(scene, numbers);
   if (!emission) return;
   const auto leaveVpl = [&](const LightWalkVertex& v) {
     if (!v.bsdf.isNearSpecular()) {
@@ -41,7 +42,7 @@ void traceLightPath(const RenderScene& scene, const VplSettings& settings, uint6
     }
     return true;
   };
-  out.rays += walkLightPath(scene, rng, *emission, settings.maxDepth, leaveVpl, [](const LightWalkVertex&, const BsdfSample&, float) {});
+  out.rays += walkLightPath(scene, numbers, *emission, settings.maxDepth, leaveVpl, [](const LightWalkVertex&, const BsdfSample&, float) {});
 }
 
 }  // namespace

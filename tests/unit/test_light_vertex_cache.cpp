@@ -7,6 +7,7 @@
 #include <vector>
 #include "render/integrator/light_vertex_cache.h"
 #include "render/sampling/rng.h"
+#include "render/vpl/light_walk.h"
 #include "render/scene/gltf_loader.h"
 #include "tests/unit/support.h"
 
@@ -142,6 +143,78 @@ TEST(LightVertexCache, RecordsFromManyThreadsGiveTheSameChoiceAsFromOne) {
   threaded.build(scene, 5, 1, kPaths, 8);
   EXPECT_GT(threaded.learnedShare(), 0.0f);
   EXPECT_EQ(statedProbabilities(single), statedProbabilities(threaded));
+}
+
+// A pass's light paths start as a pixel's samples spread: 1024 starts on the Cornell box's light (two
+// triangles, the emitter folded into the position), counted on an 8 x 8 grid over the light's
+// extent, and their directions on an 8 x 8 grid of the cosine-weighted hemisphere's disk. The
+// counts' chi-square statistic over its degrees of freedom, about 1 for random starts, falls far
+// below it when the starts are stratified (measured: positions 0.073 against 1.03 for random,
+// directions 0.056 against 0.83).
+double startChiSquarePerDegree(const RenderScene& scene, bool stratified, bool directions) {
+  constexpr int kStarts = 1024, kGrid = 8;
+  std::vector<glm::vec2> points;
+  for (int i = 0; i < kStarts; ++i) {
+    std::optional<EmissionSample> e;
+    if (stratified) {
+      StratifiedWalkNumbers numbers{PixelSampler(11, ~uint64_t(0), uint64_t(i))};
+      e = startLightPath(scene, numbers);
+    } else {
+      Rng rng = Rng::hashed(uint64_t(i) * 7919u + 11u);
+      RandomWalkNumbers numbers{rng};
+      e = startLightPath(scene, numbers);
+    }
+    if (!e) continue;
+    // The light faces down (-y): its extent in x and z; a direction's x and z on the unit disk.
+    points.push_back(directions ? glm::vec2(e->direction.x, e->direction.z) * 0.5f + 0.5f
+                                : glm::vec2(e->position.x, e->position.z));
+  }
+  EXPECT_EQ(points.size(), size_t(kStarts));
+  glm::vec2 lo(INFINITY), hi(-INFINITY);
+  for (const glm::vec2& p : points) lo = glm::min(lo, p), hi = glm::max(hi, p);
+  if (directions) lo = glm::vec2(0.0f), hi = glm::vec2(1.0f);
+  std::vector<double> counts(kGrid * kGrid, 0.0), expected(kGrid * kGrid, 0.0);
+  for (const glm::vec2& p : points) {
+    const glm::ivec2 c = glm::min(glm::ivec2((p - lo) / (hi - lo) * float(kGrid)), glm::ivec2(kGrid - 1));
+    ++counts[size_t(c.y * kGrid + c.x)];
+  }
+  // Uniform over the light's rectangle; over the disk, the cosine-weighted hemisphere's projection is
+  // uniform on the disk: the expected share of a cell is its area inside the unit circle.
+  double chi = 0.0, total = 0.0;
+  for (int y = 0; y < kGrid; ++y)
+    for (int x = 0; x < kGrid; ++x) {
+      double inside = 1.0;
+      if (directions) {
+        constexpr int kSub = 64;
+        int n = 0;
+        for (int a = 0; a < kSub; ++a)
+          for (int b = 0; b < kSub; ++b) {
+            const double u = (x + (a + 0.5) / kSub) / kGrid * 2.0 - 1.0, v = (y + (b + 0.5) / kSub) / kGrid * 2.0 - 1.0;
+            n += u * u + v * v < 1.0;
+          }
+        inside = double(n) / (kSub * kSub);
+      }
+      expected[size_t(y * kGrid + x)] = inside;
+      total += inside;
+    }
+  int cells = 0;
+  for (size_t k = 0; k < counts.size(); ++k) {
+    const double e = expected[k] / total * double(points.size());
+    if (e < 5.0) continue;
+    chi += (counts[k] - e) * (counts[k] - e) / e;
+    ++cells;
+  }
+  return chi / double(cells - 1);
+}
+
+TEST(LightWalk, PathsOfAPassStartStratifiedOverTheLightAndItsDirections) {
+  const RenderScene scene = cornellBox();
+  for (const bool directions : {false, true}) {
+    const double stratified = startChiSquarePerDegree(scene, true, directions);
+    const double random = startChiSquarePerDegree(scene, false, directions);
+    EXPECT_LT(stratified, 0.25) << (directions ? "directions" : "positions");
+    EXPECT_GT(random, 0.5) << (directions ? "directions" : "positions") << ": the test no longer tells the two apart";
+  }
 }
 
 }  // namespace
