@@ -161,11 +161,11 @@ class VertexSamples {
   // The same number, for a continuation strategy of its own where no joins are made (bench/portal_bound).
   float strategy() { return connectionChoice(); }
   // The numbers every vertex reads, drawn before its ray is traced: their hash chains are long and
-  // independent of the hit, so the core works them out in the shadow of the traversal.
+  // independent of the hit, so the core works them out in the shadow of the traversal. (The light
+  // choice is folded into the light point but where emitters are many: not every vertex reads it.)
   void drawAhead() {
     lightPoint();
     bsdfDirection();
-    lightChoice();
   }
   // The vertex's own random stream (Metropolis chains), made on first use.
   Rng& random() {

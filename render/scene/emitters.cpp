@@ -177,7 +177,7 @@ std::optional<LightSample> EmitterSet::sample(const glm::vec3& p, float uLight, 
 }
 
 std::optional<LightSample> EmitterSet::sampleStratified(const glm::vec3& p, glm::vec2 u, float uSpare) const {
-  if (distribution_.size() > kMaxFoldedChoices) return sample(p, uSpare, u);
+  if (!foldsChoice()) return sample(p, uSpare, u);
   if (distribution_.empty()) return std::nullopt;
   float pmf = 0.0f;
   const size_t index = distribution_.sample(u.x, &pmf, &u.x);
@@ -340,7 +340,7 @@ std::optional<EmissionSample> EmitterSet::sampleEmission(float uLight, glm::vec2
 }
 
 std::optional<EmissionSample> EmitterSet::sampleEmissionStratified(glm::vec2 uPos, glm::vec2 uDir, float uSpare) const {
-  if (distribution_.size() > kMaxFoldedChoices) return sampleEmission(uSpare, uPos, uDir);
+  if (!foldsChoice()) return sampleEmission(uSpare, uPos, uDir);
   if (distribution_.empty()) return std::nullopt;
   float pmf = 0.0f;
   const size_t index = distribution_.sample(uPos.x, &pmf, &uPos.x);

@@ -59,6 +59,8 @@ class EmitterSet {
   // x would keep too few bits, and uSpare makes the choice as sample() does.
   std::optional<LightSample> sampleStratified(const glm::vec3& p, glm::vec2 u, float uSpare) const;
   static constexpr size_t kMaxFoldedChoices = 256;  // 16 of the number's 24 bits left for the point
+  // Whether the sampleStratified functions fold the choice (and leave uSpare unread).
+  bool foldsChoice() const { return distribution_.size() <= kMaxFoldedChoices; }
   // Density (solid angle, at p) with which sample() picks the emitting triangle point x of a hit.
   float pdfTriangle(const glm::vec3& p, const SurfaceHit& hit) const;
   // Whether sample() draws the emitting triangle (mesh, triangle) by solid angle from p (else by
