@@ -97,7 +97,7 @@ class LightVertexCache {
   // emitter folded into the position's x, and its first scatterings; render/vpl/light_walk.h) or
   // numbers hashed from (seed, pass, path). Subpaths end after maxLength segments or by Russian
   // roulette. Empty for lights that connections do not support.
-  void build(const RenderScene& scene, uint64_t seed, uint64_t pass, int paths, int maxLength, bool stratified = true);
+  void build(const RenderScene& scene, uint64_t seed, uint64_t pass, int paths, int maxLength, bool stratified);
 
   bool empty() const { return vertices_.empty(); }
   int joinsPerVertex() const { return joinsPerVertex_; }

@@ -6,6 +6,8 @@
 // (seed, pixel, slot). The first 2^m samples of any slot in a pixel are stratified (a (0,m,2)-net),
 // different slots and pixels are independent of each other. Two 1D decisions of a vertex share one
 // 2D slot, jointly stratified; the second is computed only when asked (most vertices ask for one).
+// A light path of the light vertex cache uses the same slots, its index in the pass as the sample
+// index (render/vpl/light_walk.h: vertex 0 its start, vertex k its k-th scattering).
 //
 // Slot layout: the camera jitter, the preview's cluster choice, then per path vertex (its depth:
 // 0 is the camera ray's hit) a block of VertexDimension. Past kTabulatedVertices, and for consumers
@@ -22,9 +24,9 @@ namespace vpl {
 
 // The slots of one path vertex, all 2D.
 enum class VertexDimension : uint32_t {
-  LightPoint,           // the point on the chosen emitter (next-event estimation)
+  LightPoint,           // the point on the chosen emitter (next-event estimation); x also picks the emitter (EmitterSet::sampleStratified)
   BsdfDirection,        // the BSDF's direction; x also picks its lobe (Bsdf::sample(wo, u))
-  LightChoiceRoulette,  // x: which emitter, where too many to fold into LightPoint's x (EmitterSet::sampleStratified); y: Russian roulette
+  LightChoiceRoulette,  // x: which emitter, where EmitterSet::foldsChoice() is false; y: Russian roulette
   StrategyGuideCell,    // x: the light vertices a vertex joins, or a free strategy where none are (mis takes its strategy from BsdfDirection's x); y: the guide's cell or its defensive share
   GuidePoint,           // the point within the guide's cell
   Count

@@ -121,6 +121,10 @@ EmitterSet::EmitterSet(const SceneData& scene, const glm::vec3& sky, const glm::
     power.push_back(4.0f * kPi * kPi * radius_ * radius_ * luminance(sky));
   }
   distribution_ = AliasTable(power);
+  bool foldable = !distribution_.empty();
+  for (size_t i = 0; i < power.size(); ++i)
+    if (distribution_.pmf(i) > 0.0f && distribution_.pmf(i) < kMinFoldedShare) foldable = false;
+  if (foldable) foldedChoice_ = Distribution1D(power);
 }
 
 EmitterSet::TrianglePoint EmitterSet::trianglePoint(const TriangleLight& light, glm::vec2 b) const {
@@ -178,10 +182,8 @@ std::optional<LightSample> EmitterSet::sample(const glm::vec3& p, float uLight, 
 
 std::optional<LightSample> EmitterSet::sampleStratified(const glm::vec3& p, glm::vec2 u, float uSpare) const {
   if (!foldsChoice()) return sample(p, uSpare, u);
-  if (distribution_.empty()) return std::nullopt;
-  float pmf = 0.0f;
-  const size_t index = distribution_.sample(u.x, &pmf, &u.x);
-  return sampleChosen(p, index, pmf, u);
+  const size_t index = foldedChoice_.sample(u.x, nullptr, &u.x);
+  return sampleChosen(p, index, distribution_.pmf(index), u);  // the pmf pdfTriangle uses
 }
 
 std::optional<LightSample> EmitterSet::sampleChosen(const glm::vec3& p, size_t index, float pmf, glm::vec2 u) const {
@@ -341,10 +343,8 @@ std::optional<EmissionSample> EmitterSet::sampleEmission(float uLight, glm::vec2
 
 std::optional<EmissionSample> EmitterSet::sampleEmissionStratified(glm::vec2 uPos, glm::vec2 uDir, float uSpare) const {
   if (!foldsChoice()) return sampleEmission(uSpare, uPos, uDir);
-  if (distribution_.empty()) return std::nullopt;
-  float pmf = 0.0f;
-  const size_t index = distribution_.sample(uPos.x, &pmf, &uPos.x);
-  return sampleEmissionChosen(index, pmf, uSpare, uPos, uDir);
+  const size_t index = foldedChoice_.sample(uPos.x, nullptr, &uPos.x);
+  return sampleEmissionChosen(index, distribution_.pmf(index), uSpare, uPos, uDir);
 }
 
 std::optional<EmissionSample> EmitterSet::sampleEmissionChosen(size_t index, float pmf, float uSide, glm::vec2 uPos,

@@ -10,6 +10,7 @@
 #include <vector>
 #include <glm/glm.hpp>
 #include "render/sampling/alias_table.h"
+#include "render/sampling/distribution_1d.h"
 #include "render/sampling/spherical_triangle.h"
 #include "render/scene/scene_data.h"
 #include "render/scene/surface.h"
@@ -52,15 +53,18 @@ class EmitterSet {
 
   // Next-event estimation from point p; u = three uniforms.
   std::optional<LightSample> sample(const glm::vec3& p, float uLight, glm::vec2 u) const;
-  // The same with the emitter's choice folded into u.x, rescaled within the chosen emitter's share
-  // (as Bsdf::sample(wo, u) picks its lobe): a stratified u then stays stratified over each emitter's
-  // points, where a choice of its own hands each emitter a random subset of them (the Cornell box's
-  // two-triangle light, brdf at 64 spp: relMSE 0.97x). Over kMaxFoldedChoices entries the rescaled
-  // x would keep too few bits, and uSpare makes the choice as sample() does.
+  // The same density, with the emitter's choice folded into u.x: each emitter owns one interval of
+  // x (a CDF, not the alias table, which splits an emitter's share over several bins), and x
+  // rescaled within it serves the point (as Bsdf::sample(wo, u) picks its lobe). A stratified u then
+  // stays stratified over each emitter's points, where a choice of its own hands each emitter a
+  // random subset of them (the Cornell box's two-triangle light, brdf at 64 spp: relMSE 0.97x).
+  // An emitter whose share is below kMinFoldedShare would keep too few of x's 24 bits for its
+  // points (a share of 1e-6: 17 values, a biased quadrature), so where any is, uSpare makes the
+  // choice as sample() does.
   std::optional<LightSample> sampleStratified(const glm::vec3& p, glm::vec2 u, float uSpare) const;
-  static constexpr size_t kMaxFoldedChoices = 256;  // 16 of the number's 24 bits left for the point
+  static constexpr float kMinFoldedShare = 1.0f / 256.0f;  // 16 bits or more left for the point
   // Whether the sampleStratified functions fold the choice (and leave uSpare unread).
-  bool foldsChoice() const { return distribution_.size() <= kMaxFoldedChoices; }
+  bool foldsChoice() const { return !foldedChoice_.empty(); }
   // Density (solid angle, at p) with which sample() picks the emitting triangle point x of a hit.
   float pdfTriangle(const glm::vec3& p, const SurfaceHit& hit) const;
   // Whether sample() draws the emitting triangle (mesh, triangle) by solid angle from p (else by
@@ -72,7 +76,8 @@ class EmitterSet {
   // Starting vertex of a light path, for VPL tracing.
   std::optional<EmissionSample> sampleEmission(float uLight, glm::vec2 uPos, glm::vec2 uDir) const;
   // The same with the emitter's choice folded into uPos.x, as sampleStratified() folds it; uSpare
-  // picks the side of a two-sided emitter, and the emitter too past kMaxFoldedChoices.
+  // picks the side of a two-sided emitter, and the emitter too where the choice is not folded.
+  // sampleEmission()'s densities hold for it.
   std::optional<EmissionSample> sampleEmissionStratified(glm::vec2 uPos, glm::vec2 uDir, float uSpare) const;
   // Density with which sampleEmission() starts at the emitting point of a hit and leaves along
   // `direction` (area x solid angle, light choice included): the light-tracing side of a camera
@@ -110,6 +115,9 @@ class EmitterSet {
   // For each mesh, the emitter index of each triangle (empty for non-emissive meshes).
   std::vector<std::vector<int32_t>> triangleIndex_;
   AliasTable distribution_;  // over [triangles..., punctual..., sky]
+  // The same choice as a CDF for the folded samplers; empty where some emitter's share is below
+  // kMinFoldedShare (or there are none).
+  Distribution1D foldedChoice_;
   int skyIndex_ = -1;
   glm::vec3 sky_{0.0f};
   glm::vec3 centre_{0.0f};
@@ -120,12 +128,12 @@ class EmitterSet {
     glm::vec3 position, normal;  // normal from the winding (the front side)
   };
   TrianglePoint trianglePoint(const TriangleLight& light, glm::vec2 barycentric) const;
-  // The spherical triangle of `light` seen from p when sample() samples it by solid angle from
-  // there; nullopt when it samples by area.
   // sampleEmission() once the emitter `index` is chosen with probability pmf.
   std::optional<EmissionSample> sampleEmissionChosen(size_t index, float pmf, float uSide, glm::vec2 uPos, glm::vec2 uDir) const;
   // sample() once the emitter `index` is chosen with probability pmf.
   std::optional<LightSample> sampleChosen(const glm::vec3& p, size_t index, float pmf, glm::vec2 u) const;
+  // The spherical triangle of `light` seen from p when sample() samples it by solid angle from
+  // there; nullopt when it samples by area.
   static std::optional<SphericalTriangle> solidAngleStrategy(const glm::vec3& p, const TriangleLight& light);
   // Signed distance from p to the triangle's plane (positive on the front side), or NaN when p lies
   // in that plane as far as the renderer can tell: no light from the triangle reaches p then.

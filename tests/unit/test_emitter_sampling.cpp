@@ -559,35 +559,81 @@ TEST(EmitterSampling, FoldedChoiceKeepsAGridStratifiedOverEachTriangle) {
   }
 }
 
-TEST(EmitterSampling, ManyEmittersTakeTheSpareNumberForTheChoice) {
-  // Past kMaxFoldedChoices the rescaled x would keep too few bits for the point: the spare number
-  // chooses, exactly as sample() does.
-  SceneData scene = emitterScene();
-  scene.meshes.pop_back();
+TEST(EmitterSampling, AnEmitterWithASmallShareLeavesTheChoiceToTheSpareNumber) {
+  // An emitter with a share below kMinFoldedShare would get too few values of x for its points:
+  // there the spare number chooses, exactly as sample() does. The quad alone folds; the quad with
+  // a dim triangle (a millionth of its power) does not, nor does it with 257 small ones of equal
+  // power.
+  SceneData quadOnly = emitterScene();
+  quadOnly.meshes.pop_back();
+  EXPECT_TRUE(EmitterSet(quadOnly, glm::vec3(0.0f), glm::vec3(0.0f), 3.0f).foldsChoice());
+
+  SceneData dim = quadOnly;
+  Material dimLight = dim.materials[1];
+  dimLight.emission *= 1e-6f;
+  dim.materials.push_back(dimLight);
+  MeshData dimTriangle = dim.meshes[0];
+  dimTriangle.indices.resize(3);
+  dimTriangle.material = uint32_t(dim.materials.size() - 1);
+  dim.meshes.push_back(dimTriangle);
+
+  SceneData many = quadOnly;
   MeshData strip;
   strip.material = 1;
-  for (uint32_t t = 0; t <= EmitterSet::kMaxFoldedChoices; ++t) {
+  for (uint32_t t = 0; t < 257; ++t) {
     const float x = 0.01f * float(t);
     strip.positions.insert(strip.positions.end(), {{x, 2.0f, 0.0f}, {x, 2.0f, 0.01f}, {x + 0.01f, 2.0f, 0.0f}});
     strip.indices.insert(strip.indices.end(), {3 * t, 3 * t + 1, 3 * t + 2});
   }
-  scene.meshes.push_back(strip);
-  const EmitterSet emitters(scene, glm::vec3(0.0f), glm::vec3(0.0f), 10.0f);
-  ASSERT_GT(emitters.triangleCount(), EmitterSet::kMaxFoldedChoices);
-  Uniforms u(67);
-  int same = 0;
-  for (int s = 0; s < 1000; ++s) {
-    const glm::vec2 uPoint = u.next2();
-    const float uSpare = u.next();
-    const auto a = emitters.sampleStratified(kReceivers[1].p, uPoint, uSpare);
-    const auto b = emitters.sample(kReceivers[1].p, uSpare, uPoint);
-    ASSERT_EQ(a.has_value(), b.has_value());
-    if (!a) continue;
-    EXPECT_EQ(a->wi, b->wi);
-    EXPECT_EQ(a->pdf, b->pdf);
-    ++same;
+  many.meshes.push_back(strip);
+
+  for (const SceneData* scene : {&dim, &many}) {
+    const EmitterSet emitters(*scene, glm::vec3(0.0f), glm::vec3(0.0f), 10.0f);
+    EXPECT_FALSE(emitters.foldsChoice());
+    Uniforms u(67);
+    int same = 0;
+    for (int s = 0; s < 1000; ++s) {
+      const glm::vec2 uPoint = u.next2();
+      const float uSpare = u.next();
+      const auto a = emitters.sampleStratified(kReceivers[1].p, uPoint, uSpare);
+      const auto b = emitters.sample(kReceivers[1].p, uSpare, uPoint);
+      ASSERT_EQ(a.has_value(), b.has_value());
+      if (!a) continue;
+      EXPECT_EQ(a->wi, b->wi);
+      EXPECT_EQ(a->pdf, b->pdf);
+      ++same;
+    }
+    EXPECT_GT(same, 500);
   }
-  EXPECT_GT(same, 500);
+}
+
+TEST(EmitterSampling, FoldedEmissionTakesItsSideFromTheSpareNumber) {
+  // A two-sided quad's light paths leave from either side half the time, and from points spread
+  // the same way over the quad on both sides: the side must not be read from the point's number.
+  SceneData scene = emitterScene();
+  scene.meshes.pop_back();
+  scene.materials[1].doubleSided = true;
+  const EmitterSet emitters(scene, glm::vec3(0.0f), glm::vec3(0.0f), 3.0f);
+  ASSERT_TRUE(emitters.foldsChoice());
+  Uniforms u(71);
+  const int n = 200000;
+  int front = 0;
+  glm::dvec3 meanFront(0.0), meanBack(0.0);
+  for (int s = 0; s < n; ++s) {
+    const glm::vec2 uPos = u.next2(), uDir = u.next2();
+    const auto e = emitters.sampleEmissionStratified(uPos, uDir, u.next());
+    ASSERT_TRUE(e.has_value());
+    if (e->normal.y < 0.0f) {  // the quad's front faces -y
+      ++front;
+      meanFront += glm::dvec3(e->position);
+    } else {
+      meanBack += glm::dvec3(e->position);
+    }
+  }
+  EXPECT_NEAR(double(front) / n, 0.5, 0.005);
+  meanFront /= double(front);
+  meanBack /= double(n - front);
+  EXPECT_LT(glm::length(meanFront - meanBack), 0.02) << "the sides' points spread differently";
 }
 
 TEST(EmitterSampling, NextEventEstimateMatchesPolygonIrradiance) {

@@ -65,10 +65,10 @@ RenderScene cornellBox() { return RenderScene(loadGltf(test::sourceDir() + "/sce
 TEST(LightVertexCache, UniformChoiceGivesEveryVertexTheSameProbability) {
   const RenderScene scene = cornellBox();
   LightVertexCache cache(kOneUniformJoin);
-  cache.build(scene, 1, 0, kPaths, 8);
+  cache.build(scene, 1, 0, kPaths, 8, true);
   ASSERT_FALSE(cache.empty());
   for (size_t i = 0; i < cache.vertices().size(); ++i) cache.record(cache.vertices()[i], 5.0f);  // ignored
-  cache.build(scene, 1, 1, kPaths, 8);
+  cache.build(scene, 1, 1, kPaths, 8, true);
   EXPECT_EQ(cache.learnedShare(), 0.0f);
   const std::vector<double> p = statedProbabilities(cache);
   for (const double pi : p) EXPECT_NEAR(pi * double(p.size()), 1.0, 1e-4);
@@ -80,7 +80,7 @@ TEST(LightVertexCache, UniformChoiceGivesEveryVertexTheSameProbability) {
 TEST(LightVertexCache, LearnedChoiceDrawsEachVertexWithTheProbabilityItsScaleStates) {
   const RenderScene scene = cornellBox();
   LightVertexCache cache(kOneJoin);
-  cache.build(scene, 1, 0, kPaths, 8);
+  cache.build(scene, 1, 0, kPaths, 8, true);
   ASSERT_FALSE(cache.empty());
   EXPECT_EQ(cache.learnedShare(), 0.0f);  // nothing learned yet: uniform
   std::map<uint32_t, int> cellsSeen;
@@ -89,7 +89,7 @@ TEST(LightVertexCache, LearnedChoiceDrawsEachVertexWithTheProbabilityItsScaleSta
   // Joins to the vertices of every third cell brought light back, the rest none.
   for (const LightVertex& v : cache.vertices())
     if (v.cell % 3 == 0) cache.record(v, 0.25f);
-  cache.build(scene, 1, 1, kPaths, 8);
+  cache.build(scene, 1, 1, kPaths, 8, true);
   EXPECT_FLOAT_EQ(cache.learnedShare(), 1.0f - LightVertexCache::kUniformShare);
 
   const std::vector<double> p = statedProbabilities(cache);
@@ -112,13 +112,13 @@ TEST(LightVertexCache, LearnedChoiceDrawsEachVertexWithTheProbabilityItsScaleSta
 TEST(LightVertexCache, RecordsInAnyOrderGiveTheSameChoice) {
   const RenderScene scene = cornellBox();
   LightVertexCache forward(kOneJoin), backward(kOneJoin);
-  forward.build(scene, 3, 0, kPaths, 8);
-  backward.build(scene, 3, 0, kPaths, 8);
+  forward.build(scene, 3, 0, kPaths, 8, true);
+  backward.build(scene, 3, 0, kPaths, 8, true);
   const std::vector<LightVertex>& v = forward.vertices();
   for (size_t i = 0; i < v.size(); ++i) forward.record(v[i], 0.1f + 0.37f * float(i % 7));
   for (size_t i = v.size(); i-- > 0;) backward.record(backward.vertices()[i], 0.1f + 0.37f * float(i % 7));
-  forward.build(scene, 3, 1, kPaths, 8);
-  backward.build(scene, 3, 1, kPaths, 8);
+  forward.build(scene, 3, 1, kPaths, 8, true);
+  backward.build(scene, 3, 1, kPaths, 8, true);
   EXPECT_EQ(statedProbabilities(forward), statedProbabilities(backward));
 }
 
@@ -127,8 +127,8 @@ TEST(LightVertexCache, RecordsInAnyOrderGiveTheSameChoice) {
 TEST(LightVertexCache, RecordsFromManyThreadsGiveTheSameChoiceAsFromOne) {
   const RenderScene scene = cornellBox();
   LightVertexCache single(kOneJoin), threaded(kOneJoin);
-  single.build(scene, 5, 0, kPaths, 8);
-  threaded.build(scene, 5, 0, kPaths, 8);
+  single.build(scene, 5, 0, kPaths, 8, true);
+  threaded.build(scene, 5, 0, kPaths, 8, true);
   const auto value = [](size_t i) { return 0.2f + 0.53f * float(i % 5); };
   for (size_t i = 0; i < single.vertices().size(); ++i) single.record(single.vertices()[i], value(i));
   constexpr size_t kThreads = 4;
@@ -139,10 +139,26 @@ TEST(LightVertexCache, RecordsFromManyThreadsGiveTheSameChoiceAsFromOne) {
       for (size_t i = t; i < v.size(); i += kThreads) threaded.record(v[i], value(i));
     });
   for (std::thread& t : threads) t.join();
-  single.build(scene, 5, 1, kPaths, 8);
-  threaded.build(scene, 5, 1, kPaths, 8);
+  single.build(scene, 5, 1, kPaths, 8, true);
+  threaded.build(scene, 5, 1, kPaths, 8, true);
   EXPECT_GT(threaded.learnedShare(), 0.0f);
   EXPECT_EQ(statedProbabilities(single), statedProbabilities(threaded));
+}
+
+// `--sampler random` reaches the light paths: the same seed and pass trace other paths than the
+// stratified ones, and the same paths again when asked twice.
+TEST(LightVertexCache, TheRandomSamplerGivesTheLightPathsNumbersOfTheirOwn) {
+  const RenderScene scene = cornellBox();
+  const auto positions = [&](bool stratified) {
+    LightVertexCache cache(kOneUniformJoin);
+    cache.build(scene, 9, 0, kPaths, 8, stratified);
+    std::vector<glm::vec3> p;
+    for (const LightVertex& v : cache.vertices()) p.push_back(v.position);
+    return p;
+  };
+  EXPECT_EQ(positions(true), positions(true));
+  EXPECT_EQ(positions(false), positions(false));
+  EXPECT_NE(positions(true), positions(false));
 }
 
 // A pass's light paths start as a pixel's samples spread: 1024 starts on the Cornell box's light (two

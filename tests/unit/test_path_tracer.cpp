@@ -39,7 +39,7 @@ Rendered renderScene(const RenderScene& scene, int width, int height, int spp, u
   Film film(width, height);
   Rendered r;
   for (int pass = 0; pass < spp; ++pass) {
-    if (connectPaths > 0) connections.build(scene, seed, uint64_t(pass), connectPaths, maxDepth - 1);
+    if (connectPaths > 0) connections.build(scene, seed, uint64_t(pass), connectPaths, maxDepth - 1, true);
     r.stats += renderer.renderPass(film, uint64_t(pass));
   }
   r.image = film.resolve();
