@@ -237,10 +237,7 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
       }
 
       // Next-event estimation: one light sample, MIS with the continuation strategy.
-      // The emitter's own number only where its choice is not folded into the point (it is not
-      // drawn ahead: 2.4 % of a brdf sample's time).
-      const float uSpare = emitters.foldsChoice() ? 0.0f : u.lightChoice();
-      if (const auto ls = emitters.sampleStratified(surface.position, u.lightPoint(), uSpare)) {
+      if (const auto ls = emitters.sampleStratified(surface.position, u.lightPoint(), [&] { return u.lightChoice(); })) {
         const glm::vec3 f = glm::dot(ls->wi, surface.geometricNormal) > 0.0f ? bsdf.eval(wo, ls->wi) : glm::vec3(0.0f);
         if (!isBlack(f)) {
           ++stats.rays;

@@ -163,8 +163,9 @@ class VertexSamples {
   // The same number, for a continuation strategy of its own where no joins are made (bench/portal_bound).
   float strategy() { return connectionChoice(); }
   // The numbers every vertex reads, drawn before its ray is traced: their hash chains are long and
-  // independent of the hit, so the core works them out in the shadow of the traversal. (The light
-  // choice is folded into the light point but where emitters are many: not every vertex reads it.)
+  // independent of the hit, so the core works them out in the shadow of the traversal. (Not the light
+  // choice: EmitterSet::sampleStratified folds it into the light point and asks for it only where it
+  // cannot; drawing it ahead cost 2.4 % of a brdf sample's time.)
   void drawAhead() {
     lightPoint();
     bsdfDirection();

@@ -180,8 +180,7 @@ std::optional<LightSample> EmitterSet::sample(const glm::vec3& p, float uLight, 
   return sampleChosen(p, index, pmf, u);
 }
 
-std::optional<LightSample> EmitterSet::sampleStratified(const glm::vec3& p, glm::vec2 u, float uSpare) const {
-  if (!foldsChoice()) return sample(p, uSpare, u);
+std::optional<LightSample> EmitterSet::sampleFolded(const glm::vec3& p, glm::vec2 u) const {
   const size_t index = foldedChoice_.sample(u.x, nullptr, &u.x);
   return sampleChosen(p, index, distribution_.pmf(index), u);  // the pmf pdfTriangle uses
 }

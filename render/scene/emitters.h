@@ -61,7 +61,14 @@ class EmitterSet {
   // An emitter whose share is below kMinFoldedShare would keep too few of x's 24 bits for its
   // points (a share of 1e-6: 17 values, a biased quadrature), so where any is, uSpare makes the
   // choice as sample() does.
-  std::optional<LightSample> sampleStratified(const glm::vec3& p, glm::vec2 u, float uSpare) const;
+  // spareNumber() (a float in [0, 1)) is asked only then: callers need not draw it ahead.
+  template <class SpareNumber>
+  std::optional<LightSample> sampleStratified(const glm::vec3& p, glm::vec2 u, SpareNumber&& spareNumber) const {
+    return foldsChoice() ? sampleFolded(p, u) : sample(p, spareNumber(), u);
+  }
+  std::optional<LightSample> sampleStratified(const glm::vec3& p, glm::vec2 u, float uSpare) const {
+    return sampleStratified(p, u, [uSpare] { return uSpare; });
+  }
   static constexpr float kMinFoldedShare = 1.0f / 256.0f;  // 16 bits or more left for the point
   // Whether the sampleStratified functions fold the choice (and leave uSpare unread).
   bool foldsChoice() const { return !foldedChoice_.empty(); }
@@ -130,6 +137,8 @@ class EmitterSet {
   TrianglePoint trianglePoint(const TriangleLight& light, glm::vec2 barycentric) const;
   // sampleEmission() once the emitter `index` is chosen with probability pmf.
   std::optional<EmissionSample> sampleEmissionChosen(size_t index, float pmf, float uSide, glm::vec2 uPos, glm::vec2 uDir) const;
+  // sampleStratified() where foldsChoice().
+  std::optional<LightSample> sampleFolded(const glm::vec3& p, glm::vec2 u) const;
   // sample() once the emitter `index` is chosen with probability pmf.
   std::optional<LightSample> sampleChosen(const glm::vec3& p, size_t index, float pmf, glm::vec2 u) const;
   // The spherical triangle of `light` seen from p when sample() samples it by solid angle from

@@ -101,8 +101,7 @@ uint32_t blendedSlice(const VplField& field, uint32_t g, float u) {
 // One emitter sample, unweighted: the preview has no BSDF-sampled light to combine it with.
 glm::vec3 directLight(const RenderScene& scene, const SurfaceHit& surface, const Bsdf& bsdf, const glm::vec3& wo,
                       VertexSamples u, PathStats& stats) {
-  const auto ls = scene.emitters().sampleStratified(
-      surface.position, u.lightPoint(), scene.emitters().foldsChoice() ? 0.0f : u.lightChoice());
+  const auto ls = scene.emitters().sampleStratified(surface.position, u.lightPoint(), [&] { return u.lightChoice(); });
   if (!ls) return glm::vec3(0.0f);
   const glm::vec3 f = bsdf.eval(wo, ls->wi);
   if (isBlack(f) || glm::dot(ls->wi, surface.geometricNormal) <= 0.0f) return glm::vec3(0.0f);
