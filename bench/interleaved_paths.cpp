@@ -4,8 +4,8 @@
 // out-of-order core can overlap them. This bench runs the same estimator as PathTracer::radiance in
 // --mode brdf (next-event estimation with MIS, square-root roulette from depth rr-start, no
 // connections, no weight window) with K = 1, 2, 4 lanes, single-threaded, against radiance() itself,
-// and prints the time per sample and the image mean of each (the means agree within noise: the
-// same estimator).
+// and prints the time per sample and the image mean of each (equal: the same estimator on the same
+// numbers, so every lane count makes radiance()'s image).
 // Usage: interleaved_paths SCENE [WIDTH HEIGHT PASSES ROUNDS]
 #include <algorithm>
 #include <chrono>
