@@ -82,6 +82,7 @@ nlohmann::ordered_json summaryJson(const RenderJobSettings& s, const RenderJobRe
   if (r.connectionPaths > 0) {
     j["connect_paths"] = r.connectionPaths;
     j["joins_per_vertex"] = s.connections.joinsPerVertex;
+    j["join_depth"] = s.connections.joinDepth;
     j["join_roulette"] = s.connections.shadowRoulette;
   }
   if (s.tracer.roulette == RouletteRule::Vpl || s.tracer.roulette == RouletteRule::Auto)

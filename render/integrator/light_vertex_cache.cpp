@@ -19,6 +19,7 @@ int ConnectionSettings::pathsFor(int pixels, SamplingMode mode) const {
 std::string ConnectionSettings::validate() const {
   if (paths < -1 || paths > 16'777'216) return "connection paths must be -1 (auto), 0 (off) or up to 16,777,216";
   if (joinsPerVertex < 1 || joinsPerVertex > LightVertexCache::kMaxJoinsPerVertex) return "joins per vertex must be between 1 and 16";
+  if (joinDepth < -1 || joinDepth > kMaxJoinDepth) return "join depth must be -1 (every vertex), 0, 1 or 2";
   if (!(shadowRoulette >= 0.0f && shadowRoulette <= 100.0f)) return "join roulette share must be between 0 and 100";
   return {};
 }
@@ -39,6 +40,7 @@ void traceLightSubpath(const RenderScene& scene, const LightVertexCache& cache, 
   // BSDF sampling: dVC starts at 0.
   float dVC = e->normal != glm::vec3(0.0f) ? connectionMis(glm::dot(e->normal, e->direction) / e->pdf) : 0.0f;
   float dVCM = 0.0f;
+  float dVCNotJoins = dVC, dVCJoinTwoBack = 0.0f;  // dVC's parts (LightVertex)
   const auto onVertex = [&](const LightWalkVertex& v) {
     const float cosIn = std::abs(glm::dot(v.surface.geometricNormal, v.wIn));
     if (v.length == 1) {
@@ -48,12 +50,19 @@ void traceLightSubpath(const RenderScene& scene, const LightVertexCache& cache, 
       dVCM *= connectionMis(v.distance * v.distance) / connectionMis(cosIn);
     }
     dVC /= connectionMis(cosIn);
-    out.vertices.push_back({v.surface.position, v.surface.geometricNormal, v.wIn, v.throughput / cosIn, dVC, dVCM, v.length, 0u, v.bsdf});
+    dVCNotJoins /= connectionMis(cosIn);
+    dVCJoinTwoBack /= connectionMis(cosIn);
+    out.vertices.push_back({v.surface.position, v.surface.geometricNormal, v.wIn, v.throughput / cosIn, dVC, dVCM,
+                            dVCNotJoins, dVCJoinTwoBack, v.length, 0u, v.bsdf});
     return true;
   };
   // Roulette is not counted in the MIS weights: they sum to 1 whatever it does.
   const auto onScatter = [&](const LightWalkVertex& v, const BsdfSample& s, float cosOut) {
-    dVC = connectionMis(cosOut / s.pdf) * (dVC * connectionMis(v.bsdf.pdf(s.wi, v.wIn)) + dVCM);
+    const float back = connectionMis(v.bsdf.pdf(s.wi, v.wIn)), forward = connectionMis(cosOut / s.pdf);
+    dVC = forward * (dVC * back + dVCM);
+    // dVCM here is next-event estimation at the first vertex, a join (one back) past it.
+    dVCNotJoins = forward * (dVCNotJoins * back + (v.length == 1 ? dVCM : 0.0f));
+    dVCJoinTwoBack = forward * (v.length == 1 ? 0.0f : dVCM);
     dVCM = connectionMis(1.0f / s.pdf) * cache.misFactor(v.surface.position);  // a join with its light end here
   };
   out.rays += walkLightPath(scene, numbers, *e, maxLength, onVertex, onScatter);

@@ -53,6 +53,11 @@ struct ConnectionSettings {
   // joins over 1 (3, 4): door_ajar 0.79 (0.74, 0.75), two_rooms 0.84 (0.86, 0.83), interior 0.81
   // (0.82, 0.83), Cornell box 0.94 (0.97, 1.03), cornell_glossy 1.03 (1.11, 1.20), 2 seeds for the last two.
   int joinsPerVertex = 2;
+  // The deepest camera vertex that joins (0: the camera ray's hit), or -1: every vertex. A join's
+  // weight leaves out the joins that a limit forbids on either side, so the estimate stays unbiased
+  // (LightVertex keeps the terms of the joins that a limit of kMaxJoinDepth or less may allow apart).
+  int joinDepth = -1;
+  static constexpr int kMaxJoinDepth = 2;
   // Russian roulette on a join's shadow ray: a join whose contribution, were nothing in the way, is
   // below this share of what its camera sample has brought back so far traces its ray only with
   // probability contribution / (share x that value), at least kMinShadowSurvival, and weighs one
@@ -75,6 +80,10 @@ struct LightVertex {
   // camera vertex over the squared distance.
   glm::vec3 alpha{0.0f};
   float dVC = 0.0f, dVCM = 0.0f;  // the MIS partial sums (Georgiev 2012) at this vertex
+  // For a join depth limit: the part of dVC that is not joins (next-event estimation, emitter hits),
+  // and the part that is the join two vertices back towards the light (made by a camera vertex two
+  // deeper than the one that joins here). dVCM is a join for length >= 2, next-event estimation at 1.
+  float dVCNotJoins = 0.0f, dVCJoinTwoBack = 0.0f;
   int length = 0;                 // segments from the light
   uint32_t cell = 0;              // the cache's cell of position
   Bsdf bsdf;
@@ -89,6 +98,7 @@ class LightVertexCache {
 
   explicit LightVertexCache(const ConnectionSettings& s)
       : learnChoice_(s.learnChoice), joinsPerVertex_(std::clamp(s.joinsPerVertex, 1, kMaxJoinsPerVertex)),
+        joinDepth_(s.joinDepth < 0 ? -1 : std::min(s.joinDepth, ConnectionSettings::kMaxJoinDepth)),
         shadowRoulette_(std::max(0.0f, s.shadowRoulette)), misFactor_(kCells, connectionMis(float(joinsPerVertex_))) {}
 
   // Traces `paths` light paths of pass `pass` and takes what the joins of the earlier passes
@@ -101,6 +111,16 @@ class LightVertexCache {
 
   bool empty() const { return vertices_.empty(); }
   int joinsPerVertex() const { return joinsPerVertex_; }
+  // Whether a camera vertex at `depth` joins (ConnectionSettings::joinDepth).
+  bool joinsAt(int depth) const { return joinDepth_ < 0 || depth <= joinDepth_; }
+  // The light side's sum of a join from a camera vertex at `depth` to y, over the ways of making the
+  // same path with the connection nearer the light that the depth limit allows; lightPdf: y's BSDF
+  // density from the join's direction back along the light path.
+  float lightSideSum(const LightVertex& y, int depth, float lightPdf) const {
+    if (joinDepth_ < 0) return y.dVCM + y.dVC * connectionMis(lightPdf);
+    const float oneBack = y.length == 1 || joinsAt(depth + 1) ? y.dVCM : 0.0f;
+    return oneBack + (y.dVCNotJoins + (joinsAt(depth + 2) ? y.dVCJoinTwoBack : 0.0f)) * connectionMis(lightPdf);
+  }
   float shadowRoulette() const { return shadowRoulette_; }
   const std::vector<LightVertex>& vertices() const { return vertices_; }
   // The vertex for the number u in [0, 1); scale is one over its pick probability times the path
@@ -165,6 +185,7 @@ class LightVertexCache {
 
   bool learnChoice_;
   int joinsPerVertex_;
+  int joinDepth_;
   float shadowRoulette_;
   std::vector<LightVertex> vertices_;  // grouped by cell
   // The non-empty cells: their first vertex, vertex count, pick probabilities (cumulative) and scale.

@@ -136,7 +136,7 @@ glm::vec3 PathTracer::unoccludedJoin(const SurfaceHit& surface, const Bsdf& bsdf
   // first vertex the camera side has no other strategy (no light tracing to the camera): cameraSide
   // is 0 and its densities are not needed.
   const float cameraPdf = path.depth == 0 ? continuation.pdf(surface, bsdf, wo, w) : camera.pdf;
-  const float wLight = connectionMis(cameraPdf * cosLight / dist2) * (y.dVCM + y.dVC * connectionMis(light.pdf));
+  const float wLight = connectionMis(cameraPdf * cosLight / dist2) * connections_->lightSideSum(y, path.depth, light.pdf);
   const float cameraSide = path.dVCM + (path.dVC > 0.0f ? path.dVC * connectionMis(bsdf.pdf(w, wo)) : 0.0f);
   const float wCamera = cameraSide > 0.0f ? connectionMis(y.bsdf.pdf(y.wIn, -w) * cosCamera / dist2) * cameraSide : 0.0f;
   // Over this join's own count (the other joins' counts are in the partial sums).
@@ -197,7 +197,8 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
       }
       // From here on dVCM stands for a join with its light end at this vertex (for the emitter hit
       // above, next-event estimation's sample of it), which counts as the cache's factor of joins.
-      if (connections_) path.dVCM *= connections_->misFactor(surface.position);
+      // (A join from the vertex before this one, at depth - 1, which a join depth limit may forbid.)
+      if (connections_) path.dVCM *= connections_->joinsAt(depth - 1) ? connections_->misFactor(surface.position) : 0.0f;
       if (depth + 1 > settings_.maxDepth) break;
 
       const Bsdf bsdf = scene_.bsdf(surface, wo);
@@ -206,7 +207,7 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
       std::array<const LightVertex*, LightVertexCache::kMaxJoinsPerVertex> joinTo;
       std::array<float, LightVertexCache::kMaxJoinsPerVertex> joinScale;
       int joins = 0;
-      if (connections_ && depth + 2 <= settings_.maxDepth && !connections_->empty()) {
+      if (connections_ && depth + 2 <= settings_.maxDepth && !connections_->empty() && connections_->joinsAt(depth)) {
         joins = connections_->joinsPerVertex();
         const float uJoin = u.connectionChoice();
         for (int j = 0; j < joins; ++j) {
