@@ -76,6 +76,7 @@ struct Case {
   // The guide learned from the paths with the VPLs as prior (the default), the VPL guide alone (the
   // paper's), or learned alone.
   enum class Guide { Learned, Vpl, LearnedOnly } guide = Guide::Learned;
+  int joinDepth = -1;  // the deepest camera vertex that joins (ConnectionSettings::joinDepth); -1: every vertex
 };
 
 std::string caseName(const Case& c) {
@@ -85,7 +86,8 @@ std::string caseName(const Case& c) {
          (c.roulette == RouletteRule::Vpl ? "_vpl_roulette" : c.roulette == RouletteRule::Auto ? "_auto_roulette" : "") +
          (c.mis == Case::Mis::Chain ? "_chain" : c.mis == Case::Mis::Fixed ? "_fixed_probability" : "") +
          (c.connectPaths == 0 ? "_no_connections" : c.connectPaths > 0 ? "_connections" : "") +
-         (c.guide == Case::Guide::Vpl ? "_vpl_guide" : c.guide == Case::Guide::LearnedOnly ? "_learned_only_guide" : "");
+         (c.guide == Case::Guide::Vpl ? "_vpl_guide" : c.guide == Case::Guide::LearnedOnly ? "_learned_only_guide" : "") +
+         (c.joinDepth >= 0 ? "_join_depth_" + std::to_string(c.joinDepth) : "");
 }
 
 class GuidedModes : public ::testing::TestWithParam<Case> {};
@@ -104,6 +106,7 @@ TEST_P(GuidedModes, AgreeWithBsdfSamplingPixelByPixel) {
   if (c.mis == Case::Mis::Fixed) s.guide.learnSelection = false;
   s.guide.learnDirections = c.guide != Case::Guide::Vpl;
   s.guide.vplPrior = c.guide != Case::Guide::LearnedOnly;
+  s.connections.joinDepth = c.joinDepth;
   const test::BatchEstimate guided = renderBatches(data, s, kBatches, 2000, &guideSamples, &discarded, &branches,
                                                    &windowed, &learned, &guidesLearned);
   if (c.mode == SamplingMode::Mis && s.guide.learnSelection)
@@ -151,7 +154,10 @@ INSTANTIATE_TEST_SUITE_P(
                       Case{"two_rooms.gltf", SamplingMode::Mis, 1, RouletteRule::Sqrt, Case::Mis::Default, -1, Case::Guide::Vpl},
                       Case{"door_ajar.gltf", SamplingMode::Mixture},
                       Case{"cornell_glossy.gltf", SamplingMode::Metropolis, 1, RouletteRule::Sqrt, Case::Mis::Default, -1,
-                           Case::Guide::LearnedOnly}),
+                           Case::Guide::LearnedOnly},
+                      // Joins from the first vertex only: the weights of both sides leave the deeper joins out.
+                      Case{"door_ajar.gltf", SamplingMode::Mis, 1, RouletteRule::Sqrt, Case::Mis::Default, -1,
+                           Case::Guide::Learned, 0}),
     [](const auto& info) { return caseName(info.param); });
 
 // The statistic is not blind: BSDF sampling against itself passes, and against itself 5 % brighter
