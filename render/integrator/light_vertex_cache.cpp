@@ -60,7 +60,7 @@ void traceLightSubpath(const RenderScene& scene, const LightVertexCache& cache, 
   const auto onScatter = [&](const LightWalkVertex& v, const BsdfSample& s, float cosOut) {
     const float back = connectionMis(v.bsdf.pdf(s.wi, v.wIn)), forward = connectionMis(cosOut / s.pdf);
     dVC = forward * (dVC * back + dVCM);
-    // dVCM here is next-event estimation at the first vertex, a join (one back) past it.
+    // dVCM is next-event estimation at length 1 and a join for length >= 2.
     dVCNotJoins = forward * (dVCNotJoins * back + (v.length == 1 ? dVCM : 0.0f));
     dVCJoinTwoBack = forward * (v.length == 1 ? 0.0f : dVCM);
     dVCM = connectionMis(1.0f / s.pdf) * cache.misFactor(v.surface.position);  // a join with its light end here

@@ -117,6 +117,7 @@ class LightVertexCache {
   // same path with the connection nearer the light that the depth limit allows; lightPdf: y's BSDF
   // density from the join's direction back along the light path.
   float lightSideSum(const LightVertex& y, int depth, float lightPdf) const {
+    static_assert(ConnectionSettings::kMaxJoinDepth <= 2, "a light vertex keeps only the join two back apart");
     if (joinDepth_ < 0) return y.dVCM + y.dVC * connectionMis(lightPdf);
     const float oneBack = y.length == 1 || joinsAt(depth + 1) ? y.dVCM : 0.0f;
     return oneBack + (y.dVCNotJoins + (joinsAt(depth + 2) ? y.dVCJoinTwoBack : 0.0f)) * connectionMis(lightPdf);
