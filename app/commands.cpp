@@ -82,7 +82,15 @@ nlohmann::ordered_json summaryJson(const RenderJobSettings& s, const RenderJobRe
   if (r.connectionPaths > 0) {
     j["connect_paths"] = r.connectionPaths;
     j["joins_per_vertex"] = s.connections.joinsPerVertex;
-    j["join_depth"] = s.connections.joinDepth;
+    if (s.connections.joinDepth == ConnectionSettings::kJoinDepthAuto) {
+      // The depth the trial chose (null: the render ended before it decided, at every vertex).
+      j["join_depth"] = "auto";
+      if (r.joinDepthChosen) j["join_depth_chosen"] = *r.joinDepthChosen;
+      else j["join_depth_chosen"] = nullptr;
+      j["join_depth_scores"] = r.joinDepthScores;
+    } else {
+      j["join_depth"] = s.connections.joinDepth;
+    }
     j["join_roulette"] = s.connections.shadowRoulette;
   }
   if (s.tracer.roulette == RouletteRule::Vpl || s.tracer.roulette == RouletteRule::Auto)

@@ -88,9 +88,13 @@ void RenderOptions::addCommonTo(CLI::App& command) {
   command.add_option("--joins", connections.joinsPerVertex,
                      "VPL connections: light vertices each camera vertex joins (one number, systematic over the choice)")
       ->check(CLI::Range(1, 16));
-  command.add_option("--join-depth", connections.joinDepth,
-                     "VPL connections: the deepest camera vertex that joins (0: the camera ray's hit; -1: every vertex); the MIS weights leave out the joins it forbids")
-      ->check(CLI::Range(-1, ConnectionSettings::kMaxJoinDepth));
+  command.add_option_function<std::string>(
+            "--join-depth",
+            [this](const std::string& v) { connections.joinDepth = v == "auto" ? ConnectionSettings::kJoinDepthAuto : std::stoi(v); },
+            "VPL connections: the deepest camera vertex that joins (0: the camera ray's hit; -1: every vertex; auto: "
+            "a few passes of -1, 1 and 0 each, then the one of least variance x time); the MIS weights leave out the "
+            "joins it forbids")
+      ->check(CLI::IsMember({"auto", "-1", "0", "1", "2"}));
   command.add_option("--join-roulette", connections.shadowRoulette,
                      "VPL connections: a join worth less than this share of what its sample holds already traces "
                      "its shadow ray with probability worth / (share x held) and weighs 1/that (0: every join traces)")

@@ -78,6 +78,7 @@ struct PanelSettings {
   bool connections;  // VPL connections in the guided modes
   bool learnedJoins;  // ... joined to vertices chosen by what earlier passes learned (else uniformly)
   int joinsPerVertex;  // ... this many per camera vertex
+  int joinDepth;       // ... from camera vertices up to this depth: index into kJoinDepths
   bool learnGuides;   // guides learn from the paths between passes
   bool vplPrior;      // ... starting from the VPL guide (else from a uniform one)
   bool stratifiedSampler;  // Owen-scrambled Sobol' (else independent random numbers: the paper's)
@@ -85,6 +86,16 @@ struct PanelSettings {
 
 constexpr RouletteRule kRoulettes[] = {RouletteRule::Auto, RouletteRule::Sqrt, RouletteRule::Throughput, RouletteRule::Vpl};
 constexpr const char* kRouletteNames[] = {"auto", "sqrt", "throughput", "vpl (VPL weight window)"};
+
+constexpr int kJoinDepths[] = {ConnectionSettings::kJoinDepthAuto, -1, 2, 1, 0};
+constexpr const char* kJoinDepthNames[] = {"auto (each tried, the best kept)", "every vertex", "up to depth 2",
+                                           "up to depth 1", "the camera ray's hit only"};
+
+int joinDepthIndex(int depth) {
+  for (int i = 0; i < 5; ++i)
+    if (kJoinDepths[i] == depth) return i;
+  return 1;
+}
 
 int rouletteIndex(RouletteRule rule) {
   for (int i = 0; i < 4; ++i)
@@ -146,6 +157,7 @@ int runViewer(const ViewerOptions& options) {
                         settings.guide.defensive,
                         settings.guide.uniformMutation, rouletteIndex(settings.tracer.roulette),
                         settings.connections.paths != 0, settings.connections.learnChoice, settings.connections.joinsPerVertex,
+                        joinDepthIndex(settings.connections.joinDepth),
                         settings.guide.learnDirections, settings.guide.vplPrior, settings.stratifiedSampler};
 
     Image image, variance;
@@ -237,6 +249,9 @@ int runViewer(const ViewerOptions& options) {
                     static_cast<unsigned long long>(stats.discarded), stats.rouletteWindow ? "VPL window" : settings.tracer.roulette == RouletteRule::Throughput ? "throughput" : "sqrt");
         if (stats.mode == SamplingMode::Mis && stats.learnedBsdfProbability >= 0.0)
           ImGui::Text("MIS BSDF probability: %.2f (mean learned over cache points)", stats.learnedBsdfProbability);
+        if (stats.joinDepth != SessionStats::kNoJoins)
+          ImGui::Text("joins: %s%s", stats.joinDepth < 0 ? "from every vertex" : ("up to depth " + std::to_string(stats.joinDepth)).c_str(),
+                      stats.joinDepthTrial ? (stats.joinDepthDecided ? " (auto: measured best)" : " (auto: trying the depths)") : "");
         if (isGuided(stats.mode) && stats.learnedGuideShare >= 0.0)
           ImGui::Text("guides: %.0f %% learned from the paths (mean over cache points)", 100.0 * stats.learnedGuideShare);
         if (ImGui::CollapsingHeader("VPLs and guide")) {
@@ -251,6 +266,7 @@ int runViewer(const ViewerOptions& options) {
           ImGui::Checkbox("VPL connections (guided modes)", &panel.connections);
           ImGui::Checkbox("learn which light vertex a join picks", &panel.learnedJoins);
           ImGui::SliderInt("joins per camera vertex", &panel.joinsPerVertex, 1, LightVertexCache::kMaxJoinsPerVertex);
+          ImGui::Combo("camera vertices that join", &panel.joinDepth, kJoinDepthNames, 5);
           ImGui::Checkbox("learn the guides from the paths", &panel.learnGuides);
           ImGui::Checkbox("start learning from the VPL guide", &panel.vplPrior);
           ImGui::Checkbox("stratified sampler (else independent random numbers)", &panel.stratifiedSampler);
@@ -270,6 +286,7 @@ int runViewer(const ViewerOptions& options) {
             if (panel.connections != (settings.connections.paths != 0)) next.connections.paths = panel.connections ? -1 : 0;
             next.connections.learnChoice = panel.learnedJoins;
             next.connections.joinsPerVertex = std::clamp(panel.joinsPerVertex, 1, LightVertexCache::kMaxJoinsPerVertex);
+            next.connections.joinDepth = kJoinDepths[std::clamp(panel.joinDepth, 0, 4)];
             next.guide.learnDirections = panel.learnGuides;
             next.guide.vplPrior = panel.vplPrior;
             next.stratifiedSampler = panel.stratifiedSampler;

@@ -23,6 +23,19 @@ void Film::addSample(int x, int y, const glm::vec3& L) {
   p.count.store(p.count.load(kRelaxed) + 1, kRelaxed);
 }
 
+void Film::add(const Film& other) {
+  if (other.width_ != width_ || other.height_ != height_) return;
+  for (size_t i = 0, n = size_t(width_) * size_t(height_); i < n; ++i) {
+    Pixel& p = pixels_[i];
+    const Pixel& o = other.pixels_[i];
+    addTo(p.r, o.r.load(kRelaxed));
+    addTo(p.g, o.g.load(kRelaxed));
+    addTo(p.b, o.b.load(kRelaxed));
+    addTo(p.lum2, o.lum2.load(kRelaxed));
+    p.count.store(p.count.load(kRelaxed) + o.count.load(kRelaxed), kRelaxed);
+  }
+}
+
 void Film::clear() {
   for (size_t i = 0, n = size_t(width_) * size_t(height_); i < n; ++i) {
     pixels_[i].r.store(0, kRelaxed);

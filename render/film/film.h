@@ -21,6 +21,8 @@ class Film {
   int height() const { return height_; }
 
   void addSample(int x, int y, const glm::vec3& radiance);
+  // Adds another film's samples of the same size (its sums and counts), as if they had been added here.
+  void add(const Film& other);
   void clear();
 
   Image resolve() const;           // per-pixel mean; pixels without samples are black

@@ -19,7 +19,7 @@ int ConnectionSettings::pathsFor(int pixels, SamplingMode mode) const {
 std::string ConnectionSettings::validate() const {
   if (paths < -1 || paths > 16'777'216) return "connection paths must be -1 (auto), 0 (off) or up to 16,777,216";
   if (joinsPerVertex < 1 || joinsPerVertex > LightVertexCache::kMaxJoinsPerVertex) return "joins per vertex must be between 1 and 16";
-  if (joinDepth < -1 || joinDepth > kMaxJoinDepth) return "join depth must be -1 (every vertex), 0, 1 or 2";
+  if (joinDepth < kJoinDepthAuto || joinDepth > kMaxJoinDepth) return "join depth must be auto, -1 (every vertex), 0, 1 or 2";
   if (!(shadowRoulette >= 0.0f && shadowRoulette <= 100.0f)) return "join roulette share must be between 0 and 100";
   return {};
 }

@@ -53,11 +53,13 @@ struct ConnectionSettings {
   // joins over 1 (3, 4): door_ajar 0.79 (0.74, 0.75), two_rooms 0.84 (0.86, 0.83), interior 0.81
   // (0.82, 0.83), Cornell box 0.94 (0.97, 1.03), cornell_glossy 1.03 (1.11, 1.20), 2 seeds for the last two.
   int joinsPerVertex = 2;
-  // The deepest camera vertex that joins (0: the camera ray's hit), or -1: every vertex. A join's
+  // The deepest camera vertex that joins (0: the camera ray's hit), or -1: every vertex, or -2
+  // (kJoinDepthAuto): the render tries the depths and keeps the one that pays (join_depth_trial.h). A join's
   // weight leaves out the joins that a limit forbids on either side, so the estimate stays unbiased
   // (LightVertex keeps the terms of the joins that a limit of kMaxJoinDepth or less may allow apart).
   int joinDepth = -1;
   static constexpr int kMaxJoinDepth = 2;
+  static constexpr int kJoinDepthAuto = -2;
   // Russian roulette on a join's shadow ray: a join whose contribution, were nothing in the way, is
   // below this share of what its camera sample has brought back so far traces its ray only with
   // probability contribution / (share x that value), at least kMinShadowSurvival, and weighs one
@@ -98,7 +100,7 @@ class LightVertexCache {
 
   explicit LightVertexCache(const ConnectionSettings& s)
       : learnChoice_(s.learnChoice), joinsPerVertex_(std::clamp(s.joinsPerVertex, 1, kMaxJoinsPerVertex)),
-        joinDepth_(s.joinDepth < 0 ? -1 : std::min(s.joinDepth, ConnectionSettings::kMaxJoinDepth)),
+        joinDepth_(clampJoinDepth(s.joinDepth)),
         shadowRoulette_(std::max(0.0f, s.shadowRoulette)), misFactor_(kCells, connectionMis(float(joinsPerVertex_))) {}
 
   // Traces `paths` light paths of pass `pass` and takes what the joins of the earlier passes
@@ -111,6 +113,9 @@ class LightVertexCache {
 
   bool empty() const { return vertices_.empty(); }
   int joinsPerVertex() const { return joinsPerVertex_; }
+  // Between passes only: the depth the next pass's camera vertices join to (-1: every vertex).
+  void setJoinDepth(int depth) { joinDepth_ = clampJoinDepth(depth); }
+  int joinDepth() const { return joinDepth_; }
   // Whether a camera vertex at `depth` joins (ConnectionSettings::joinDepth).
   bool joinsAt(int depth) const { return joinDepth_ < 0 || depth <= joinDepth_; }
   // The light side's sum of a join from a camera vertex at `depth` to y, over the ways of making the
@@ -159,6 +164,7 @@ class LightVertexCache {
   // overflows zeroes the weight. Any bound keeps the weights summing to 1.
   static constexpr float kLargestMisCount = 100.0f;
 
+  static int clampJoinDepth(int d) { return d < 0 ? -1 : std::min(d, ConnectionSettings::kMaxJoinDepth); }
   uint32_t cellOf(const glm::vec3& p) const {
     const glm::ivec3 c = glm::clamp(glm::ivec3(glm::clamp((p - low_) * perUnit_, 0.0f, float(kCellsPerAxis))),
                                     glm::ivec3(0), glm::ivec3(kCellsPerAxis - 1));

@@ -10,6 +10,7 @@
 #include "render/integrator/guided_continuation.h"
 #include "render/session/film_learners.h"
 #include "render/session/tile_renderer.h"
+#include "render/session/join_depth_trial.h"
 #include "render/session/window_switch.h"
 
 namespace vpl {
@@ -62,6 +63,8 @@ struct ProgressiveSession::CameraState {
     WindowSwitch window;  // the auto roulette rule's decision for this film
     std::unique_ptr<FilmLearners> learners;     // what this film's passes teach the guided continuations
     std::unique_ptr<LightVertexCache> joins;    // VPL connections: its choice of vertices learns from this film's passes
+    std::unique_ptr<JoinDepthTrial> joinTrial;  // --join-depth auto: which depth this film's passes join to
+    std::unique_ptr<Film> trialFilm;            // a trial pass's own samples
   };
   std::optional<Request> key;
   Clock::time_point restart = Clock::now();
@@ -321,7 +324,13 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
   const RouletteRule rule = settings_.tracer.roulette;
   // VPL connections: fresh light vertices before every pass, for tracers of this refinement only.
   const int joinPaths = settings_.connections.pathsFor(w * h, request.mode);
-  if (joinPaths > 0 && !mine.joins) mine.joins = std::make_unique<LightVertexCache>(settings_.connections);
+  if (joinPaths > 0 && !mine.joins) {
+    mine.joins = std::make_unique<LightVertexCache>(settings_.connections);
+    if (settings_.connections.joinDepth == ConnectionSettings::kJoinDepthAuto) {
+      mine.joinTrial = std::make_unique<JoinDepthTrial>(w, h);
+      mine.trialFilm = std::make_unique<Film>(w, h);
+    }
+  }
   std::optional<PathTracer> joinTracer, joinWindowTracer;
   auto refineTracer = [&]() -> const PathTracer& {
     const bool windowed = rule == RouletteRule::Vpl || (rule == RouletteRule::Auto && mine.window.on());
@@ -354,7 +363,23 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
     const auto t = Clock::now();
     if (joinPaths > 0) mine.joins->build(scene, settings_.seed, mine.nextPass, joinPaths, settings_.tracer.maxDepth - 1,
                                       settings_.stratifiedSampler);
-    const PassStats pass = renderer->renderPass(*mine.film, mine.nextPass++, &cancel_);
+    const uint64_t index = mine.nextPass++;
+    const bool trialPass = mine.joinTrial && JoinDepthTrial::isTrialPass(index);
+    if (mine.joinTrial) mine.joins->setJoinDepth(mine.joinTrial->depthForNext(index));
+    if (trialPass && index == JoinDepthTrial::kFirstPass) mine.joinTrial->start(*mine.film);
+    if (trialPass) mine.trialFilm->clear();
+    const auto passStart = Clock::now();
+    const PassStats pass = renderer->renderPass(trialPass ? *mine.trialFilm : *mine.film, index, &cancel_);
+    if (trialPass) {
+      if (!cancelled()) mine.joinTrial->record(index, *mine.trialFilm, secondsSince(passStart));
+      mine.film->add(*mine.trialFilm);
+    }
+    if (mine.joins) {
+      std::lock_guard lock(mutex_);
+      stats_.joinDepth = mine.joins->joinDepth();
+      stats_.joinDepthTrial = mine.joinTrial != nullptr;
+      stats_.joinDepthDecided = mine.joinTrial && mine.joinTrial->decided();
+    }
     state.renderSeconds += secondsSince(t);
     state.samples += pass.samples;
     state.rays += pass.rays;

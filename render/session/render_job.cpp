@@ -13,6 +13,7 @@
 #include "render/scene/camera.h"
 #include "render/scene/gltf_loader.h"
 #include "render/session/film_learners.h"
+#include "render/session/join_depth_trial.h"
 #include "render/session/tile_renderer.h"
 #include "render/session/window_switch.h"
 #include "render/vpl/irradiance_grid.h"
@@ -154,6 +155,14 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
   const bool autoRoulette = settings.tracer.roulette == RouletteRule::Auto && settings.mode != SamplingMode::Preview;
   WindowSwitch window;
 
+  // --join-depth auto: a few passes of each candidate depth, each into a film of its own.
+  std::optional<JoinDepthTrial> joinTrial;
+  std::optional<Film> trialFilm;
+  if (connecting && settings.connections.joinDepth == ConnectionSettings::kJoinDepthAuto) {
+    joinTrial.emplace(settings.width, settings.height);
+    trialFilm.emplace(settings.width, settings.height);
+  }
+
   const auto renderStart = Clock::now();
   std::atomic<bool> stop{false};
   std::optional<DeadlineWatch> watch;
@@ -168,8 +177,18 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
       result.timings.connections += secondsSince(t);
       result.rays += connectionCache.rays();
     }
+    const bool trialPass = joinTrial && JoinDepthTrial::isTrialPass(pass);
+    if (joinTrial) connectionCache.setJoinDepth(joinTrial->depthForNext(pass));
+    if (trialPass && pass == JoinDepthTrial::kFirstPass) joinTrial->start(film);
+    if (trialPass) trialFilm->clear();
     // The first pass always completes: a budget never leaves an empty image.
-    const PassStats stats = renderer->renderPass(film, pass, pass == 0 ? nullptr : &stop);
+    const auto passStart = Clock::now();
+    const PassStats stats = renderer->renderPass(trialPass ? *trialFilm : film, pass, pass == 0 ? nullptr : &stop);
+    if (trialPass) {
+      const bool complete = !(timed && stop.load());
+      if (complete) joinTrial->record(pass, *trialFilm, secondsSince(passStart));
+      film.add(*trialFilm);
+    }
     result.rays += stats.rays;
     result.samples += stats.samples;
     result.discarded += stats.discarded;
@@ -200,6 +219,10 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
   if (learners) {
     result.learnedBsdfProbability = learners->meanBsdfProbability();
     result.learnedGuideShare = learners->meanGuideShare();
+  }
+  if (joinTrial && joinTrial->decided()) {
+    result.joinDepthChosen = joinTrial->chosen();
+    result.joinDepthScores.assign(joinTrial->scores().begin(), joinTrial->scores().end());
   }
   result.timings.render = secondsSince(renderStart);
   result.seconds = secondsSince(loaded);

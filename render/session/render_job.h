@@ -3,6 +3,7 @@
 #pragma once
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 #include "render/film/image.h"
@@ -57,6 +58,8 @@ struct RenderJobResult {
   uint64_t proposals = 0, accepted = 0;  // Metropolis mutations
   uint64_t branches = 0;                 // extra paths grown by splitting (the vpl roulette rule)
   int windowFromPass = 0;                // the auto rule: the window's first pass (0: never used)
+  std::optional<int> joinDepthChosen;    // --join-depth auto: the trial's choice, once made
+  std::vector<double> joinDepthScores;   // its score per candidate (JoinDepthTrial::kCandidates)
   int connectionPaths = 0;               // VPL connections: light paths per pass (0: none)
   double learnedBsdfProbability = -1.0;  // mis: the mean learned BSDF probability over cache points (-1: none)
   double learnedGuideShare = -1.0;       // learned guides: the mean weight of what was learned against the VPLs

@@ -47,7 +47,7 @@ RenderJobSettings settings(const std::string& scene, SamplingMode mode, int spp,
 test::BatchEstimate renderBatches(const SceneData& data, const RenderJobSettings& base, int batches, uint64_t firstSeed,
                                   uint64_t* guideSamples = nullptr, uint64_t* discarded = nullptr,
                                   uint64_t* branches = nullptr, int* windowed = nullptr, int* learned = nullptr,
-                                  int* guidesLearned = nullptr) {
+                                  int* guidesLearned = nullptr, int* joinDepthsChosen = nullptr) {
   std::vector<Image> images;
   for (int b = 0; b < batches; ++b) {
     RenderJobSettings s = base;
@@ -59,6 +59,7 @@ test::BatchEstimate renderBatches(const SceneData& data, const RenderJobSettings
     if (windowed && r.windowFromPass > 0) ++*windowed;
     if (learned && r.learnedBsdfProbability >= 0.0) ++*learned;
     if (guidesLearned && r.learnedGuideShare > 0.0) ++*guidesLearned;
+    if (joinDepthsChosen && r.joinDepthChosen) ++*joinDepthsChosen;
     images.push_back(r.image);
   }
   return test::estimateFromBatches(images);
@@ -76,7 +77,7 @@ struct Case {
   // The guide learned from the paths with the VPLs as prior (the default), the VPL guide alone (the
   // paper's), or learned alone.
   enum class Guide { Learned, Vpl, LearnedOnly } guide = Guide::Learned;
-  int joinDepth = -1;  // the deepest camera vertex that joins (ConnectionSettings::joinDepth); -1: every vertex
+  int joinDepth = -1;  // the deepest camera vertex that joins (ConnectionSettings::joinDepth); -1: every vertex, -2: auto
 };
 
 std::string caseName(const Case& c) {
@@ -87,7 +88,8 @@ std::string caseName(const Case& c) {
          (c.mis == Case::Mis::Chain ? "_chain" : c.mis == Case::Mis::Fixed ? "_fixed_probability" : "") +
          (c.connectPaths == 0 ? "_no_connections" : c.connectPaths > 0 ? "_connections" : "") +
          (c.guide == Case::Guide::Vpl ? "_vpl_guide" : c.guide == Case::Guide::LearnedOnly ? "_learned_only_guide" : "") +
-         (c.joinDepth >= 0 ? "_join_depth_" + std::to_string(c.joinDepth) : "");
+         (c.joinDepth >= 0 ? "_join_depth_" + std::to_string(c.joinDepth) : "") +
+         (c.joinDepth == ConnectionSettings::kJoinDepthAuto ? "_join_depth_auto" : "");
 }
 
 class GuidedModes : public ::testing::TestWithParam<Case> {};
@@ -100,7 +102,7 @@ TEST_P(GuidedModes, AgreeWithBsdfSamplingPixelByPixel) {
   const test::BatchEstimate reference =
       renderBatches(data, settings(c.scene, SamplingMode::Brdf, kSpp, 0), kBatches, 1000);
   uint64_t guideSamples = 0, discarded = 0, branches = 0;
-  int windowed = 0, learned = 0, guidesLearned = 0;
+  int windowed = 0, learned = 0, guidesLearned = 0, joinDepthsChosen = 0;
   RenderJobSettings s = settings(c.scene, c.mode, kSpp, 0, c.guidedVertices, c.roulette, c.connectPaths);
   s.guide.misChain = c.mis == Case::Mis::Chain;
   if (c.mis == Case::Mis::Fixed) s.guide.learnSelection = false;
@@ -108,7 +110,9 @@ TEST_P(GuidedModes, AgreeWithBsdfSamplingPixelByPixel) {
   s.guide.vplPrior = c.guide != Case::Guide::LearnedOnly;
   s.connections.joinDepth = c.joinDepth;
   const test::BatchEstimate guided = renderBatches(data, s, kBatches, 2000, &guideSamples, &discarded, &branches,
-                                                   &windowed, &learned, &guidesLearned);
+                                                   &windowed, &learned, &guidesLearned, &joinDepthsChosen);
+  if (c.joinDepth == ConnectionSettings::kJoinDepthAuto)
+    EXPECT_EQ(joinDepthsChosen, kBatches) << "the join depth trial did not decide";
   if (c.mode == SamplingMode::Mis && s.guide.learnSelection)
     EXPECT_EQ(learned, kBatches) << "no cache point learned its probability";
   if (c.guide != Case::Guide::Vpl && c.mode != SamplingMode::Brdf)
@@ -157,7 +161,10 @@ INSTANTIATE_TEST_SUITE_P(
                            Case::Guide::LearnedOnly},
                       // Joins from the first vertex only: the weights of both sides leave the deeper joins out.
                       Case{"door_ajar.gltf", SamplingMode::Mis, 1, RouletteRule::Sqrt, Case::Mis::Default, -1,
-                           Case::Guide::Learned, 0}),
+                           Case::Guide::Learned, 0},
+                      // The join depth tried pass by pass, then the one that measured best.
+                      Case{"cornell_box.gltf", SamplingMode::Mis, 1, RouletteRule::Sqrt, Case::Mis::Default, -1,
+                           Case::Guide::Learned, ConnectionSettings::kJoinDepthAuto}),
     [](const auto& info) { return caseName(info.param); });
 
 // The statistic is not blind: BSDF sampling against itself passes, and against itself 5 % brighter

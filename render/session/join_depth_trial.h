@@ -1,0 +1,79 @@
+// `--join-depth auto`: the render measures which join depth pays on this scene and keeps it.
+//
+// Joins from every camera vertex are what make light through a slit cheap (door_ajar, two_rooms),
+// but where the lights are found directly they cost more than they bring: at equal time (10 s) the
+// Cornell box has 0.84x the relMSE with joins only up to depth 1, where door_ajar has 1.45x. The
+// trade is a property of the scene, so each candidate depth renders a few whole passes, interleaved
+// after the auto roulette's window has decided, and the depth of least variance x time wins for
+// the rest of the render. Every pass is an unbiased estimate whatever its depth (the MIS weights
+// leave out exactly the joins a depth forbids), and the choice depends only on earlier passes, so
+// the image stays unbiased.
+//
+// The measure, per candidate: the mean over pixels of its passes' sample variance of luminance,
+// each pixel weighted by 1 / (m^2 + 0.01), m the image of the passes before the trial (relMSE's
+// weights, DESIGN.md §4, with that image in place of the reference), taken as the median over nine
+// interleaved groups of rows, times the candidate's mean seconds per pass. The weights must not come from the trial's own passes: a candidate's rare bright
+// sample would raise its pixel's mean and so hide its own variance (door_ajar then chose depth 0,
+// which has 4x the relMSE of every vertex there at 16 spp). One pass of 1 sample per pixel was
+// enough to rank them: 1-spp relMSE over 6 seeds spread 2 % on the Cornell box, 20 % on door_ajar,
+// against per-sample gaps of 6-20 % and 60-250 % (README, "A guided sample's cost").
+#pragma once
+#include <array>
+#include <cstdint>
+#include <vector>
+#include "render/film/film.h"
+
+namespace vpl {
+
+class JoinDepthTrial {
+ public:
+  static constexpr std::array<int, 3> kCandidates = {-1, 1, 0};  // -1: every vertex, the fallback
+  static constexpr int kPassesEach = 3;
+  // The trial starts after the auto roulette's last decision (WindowSwitch::updateDue), so that every
+  // candidate is timed with the tracer that the rest of the render uses.
+  static constexpr uint64_t kFirstPass = 4;
+  static constexpr uint64_t kLastPass = kFirstPass + kCandidates.size() * kPassesEach - 1;
+
+  JoinDepthTrial(int width, int height);
+
+  // Before the first trial pass: the image so far, whose luminance weighs the pixels.
+  void start(const Film& film);
+  // Whether pass `pass` (0-based) is one of the trial's: render it into a film of its own, hand that
+  // to record(), then add it to the image.
+  static bool isTrialPass(uint64_t pass) { return pass >= kFirstPass && pass <= kLastPass; }
+  // The depth pass `pass` joins to: the candidates in turn during the trial, the winner after it,
+  // every vertex before it.
+  int depthFor(uint64_t pass) const;
+  // The same, for the pass about to start: past the trial, decides from what was recorded if the
+  // last trial pass never completed (a viewer's pass cancelled by a mode switch).
+  int depthForNext(uint64_t pass) {
+    if (pass > kLastPass && !decided_) decide();
+    return depthFor(pass);
+  }
+  // A complete trial pass's own film (one sample per pixel) and its wall time. The last one decides.
+  void record(uint64_t pass, const Film& passFilm, double seconds);
+
+  bool decided() const { return decided_; }
+  int chosen() const { return chosen_; }
+  // Per candidate: relative variance per pass times seconds per pass (0 before the decision).
+  const std::array<double, kCandidates.size()>& scores() const { return scores_; }
+
+ private:
+  static size_t candidateOf(uint64_t pass) { return size_t(pass - kFirstPass) % kCandidates.size(); }
+  void decide();
+
+  // The variance is a median of means over groups of rows: one rare bright sample in one pixel (a
+  // Cornell box's trial pass had one that tripled a candidate's sum) must not decide.
+  static constexpr size_t kGroups = 9;
+
+  size_t width_, pixels_;
+  std::vector<double> weight_;  // per pixel: 1 / (m^2 + 0.01), m from start()
+  // Per candidate and pixel: the sum and sum of squares of the passes' luminance.
+  std::array<std::vector<double>, kCandidates.size()> sum_, sum2_;
+  std::array<double, kCandidates.size()> seconds_{}, scores_{};
+  std::array<int, kCandidates.size()> passes_{};
+  bool decided_ = false;
+  int chosen_ = -1;
+};
+
+}  // namespace vpl
