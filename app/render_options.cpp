@@ -92,7 +92,7 @@ void RenderOptions::addCommonTo(CLI::App& command) {
             "--join-depth",
             [this](const std::string& v) { connections.joinDepth = v == "auto" ? ConnectionSettings::kJoinDepthAuto : std::stoi(v); },
             "VPL connections: the deepest camera vertex that joins (0: the camera ray's hit; -1: every vertex; auto: "
-            "a few passes of -1, 1 and 0 each, then the one of least variance x time); the MIS weights leave out the "
+            "two passes of -1 and of 1, then the one of least variance x time); the MIS weights leave out the "
             "joins it forbids")
       ->check(CLI::IsMember({"auto", "-1", "0", "1", "2"}));
   command.add_option("--join-roulette", connections.shadowRoulette,

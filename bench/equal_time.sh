@@ -6,7 +6,7 @@
 #   REF_DIR holds ref_SCENE_*.exr (the references bench/vs_cycles.sh caches; with REF_MODE=MODE set, the
 #   ones it made with that REF_MODE, ref_SCENE_*_MODE.exr, else the brdf ones); the Cornell box renders at
 #   256x256, other scenes at 320x240, 2 threads, max depth 32. Prints one line per scene and variant:
-#   scene, label, spp, mis's BSDF probability (learned: the mean), relMSE.
+#   scene, label, spp, mis's BSDF probability (learned: the mean), the join depth --join-depth auto chose, relMSE.
 # Example: bench/equal_time.sh build OUT/vs_cycles 10 1 'brdf|--mode brdf;mis|--mode mis' cornell_box door_ajar
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
@@ -33,8 +33,8 @@ for name in "$@"; do
     read -ra flags <<< "${config#*|}"
     "$exe" render "$scene" "${flags[@]}" --time "$seconds" "${size[@]}" --threads 2 --seed "$seed" --max-depth 32 \
       --out "$tmp/img.exr" 2>/dev/null | tail -1 > "$tmp/run.json"
-    read -r spp prob < <(python3 -c 'import json,sys; j=json.load(open(sys.argv[1])); print(j["spp"], j.get("bsdf_prob", "-"))' "$tmp/run.json")
+    read -r spp prob depth < <(python3 -c 'import json,sys; j=json.load(open(sys.argv[1])); print(j["spp"], j.get("bsdf_prob", "-"), j.get("join_depth_chosen", "-"))' "$tmp/run.json")
     rel=$("$exe" compare "$tmp/img.exr" "$ref" | json relmse)
-    echo "$name $label seed $seed spp $spp bsdf_prob ${prob:-none} relmse $rel"
+    echo "$name $label seed $seed spp $spp bsdf_prob ${prob:-none} join_depth ${depth:--} relmse $rel"
   done
 done

@@ -368,10 +368,9 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
     if (mine.joinTrial) mine.joins->setJoinDepth(mine.joinTrial->depthForNext(index));
     if (trialPass && index == JoinDepthTrial::kFirstPass) mine.joinTrial->start(*mine.film);
     if (trialPass) mine.trialFilm->clear();
-    const auto passStart = Clock::now();
     const PassStats pass = renderer->renderPass(trialPass ? *mine.trialFilm : *mine.film, index, &cancel_);
     if (trialPass) {
-      if (!cancelled()) mine.joinTrial->record(index, *mine.trialFilm, secondsSince(passStart));
+      if (!cancelled()) mine.joinTrial->record(index, *mine.trialFilm, secondsSince(t));  // light paths included
       mine.film->add(*mine.trialFilm);
     }
     if (mine.joins) {

@@ -171,6 +171,8 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
   for (uint64_t pass = 0;; ++pass) {
     if (!timed && int(pass) >= settings.spp) break;
     if (timed && pass > 0 && stop.load()) break;
+    // A trial pass's seconds include its light paths: a depth's cost is the whole pass's.
+    const auto passStart = Clock::now();
     if (connecting) {
       const auto t = Clock::now();
       connectionCache.build(scene, settings.seed, pass, connectionPaths, settings.tracer.maxDepth - 1, settings.stratifiedSampler);
@@ -182,7 +184,6 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
     if (trialPass && pass == JoinDepthTrial::kFirstPass) joinTrial->start(film);
     if (trialPass) trialFilm->clear();
     // The first pass always completes: a budget never leaves an empty image.
-    const auto passStart = Clock::now();
     const PassStats stats = renderer->renderPass(trialPass ? *trialFilm : film, pass, pass == 0 ? nullptr : &stop);
     if (trialPass) {
       const bool complete = !(timed && stop.load());
