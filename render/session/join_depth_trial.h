@@ -9,18 +9,25 @@
 // short: two candidates, two passes each. Depth 0 is not one: on the Cornell box it is about as
 // good as depth 1 (1-spp relMSE x cost 0.099 against 0.096), and on door_ajar and two_rooms its
 // trial passes, 4x worse per sample than every vertex's, cost more than a choice could win (a trial
-// of three depths, three passes each, at 22 spp in 10 s: two_rooms 1.4x the relMSE of every vertex). Every pass is an unbiased estimate whatever its depth (the MIS weights
-// leave out exactly the joins a depth forbids), and the choice depends only on earlier passes, so
-// the image stays unbiased.
+// of three depths, three passes each, at 22 spp in 10 s: two_rooms 1.4x the relMSE of every vertex).
+// Nor is depth 2: two passes rarely show its rare bright samples, so it won the trial on two_rooms
+// where it loses (32 spp, 3 seeds: 1.26x the relMSE at 0.9x the time).
+//
+// Opt-in, not the default: at 32 spp (3 seeds, README) it gains 4-5 % of relMSE x time on the Cornell
+// box and the glossy box and loses 15 % on door_ajar, where the two passes of depth 1 it keeps are
+// 2-4x worse per sample; the trial's share of the passes, and so that loss, falls as 1/spp.
+//
+// Every pass is an unbiased estimate whatever its depth (the MIS weights leave out exactly the
+// joins a depth forbids), and the choice depends only on earlier passes, so the image stays
+// unbiased.
 //
 // The measure, per candidate: the mean over pixels of its passes' sample variance of luminance,
 // each pixel weighted by 1 / (m^2 + 0.01), m the image of the passes before the trial (relMSE's
 // weights, DESIGN.md §4, with that image in place of the reference), taken as the median over nine
-// interleaved groups of rows, times the candidate's mean seconds per pass. The weights must not come from the trial's own passes: a candidate's rare bright
-// sample would raise its pixel's mean and so hide its own variance (door_ajar then chose depth 0,
-// which has 4x the relMSE of every vertex there at 16 spp). One pass of 1 sample per pixel was
-// enough to rank them: 1-spp relMSE over 6 seeds spread 2 % on the Cornell box, 20 % on door_ajar,
-// against per-sample gaps of 6-20 % and 60-250 % (README, "A guided sample's cost").
+// interleaved groups of rows, times the candidate's mean seconds per pass, its light paths included.
+// The weights must not come from the trial's own passes: a candidate's rare bright sample would
+// raise its pixel's mean and so hide its own variance (door_ajar then chose depth 0, which has 4x
+// the relMSE of every vertex there at 16 spp).
 #pragma once
 #include <array>
 #include <cstdint>
