@@ -33,7 +33,7 @@ for name in "$@"; do
     read -ra flags <<< "${config#*|}"
     "$exe" render "$scene" "${flags[@]}" --time "$seconds" "${size[@]}" --threads 2 --seed "$seed" --max-depth 32 \
       --out "$tmp/img.exr" 2>/dev/null | tail -1 > "$tmp/run.json"
-    read -r spp prob depth < <(python3 -c 'import json,sys; j=json.load(open(sys.argv[1])); print(j["spp"], j.get("bsdf_prob", "-"), j.get("join_depth_chosen", "-"))' "$tmp/run.json")
+    read -r spp prob depth < <(python3 -c 'import json,sys; j=json.load(open(sys.argv[1])); print(j["spp"], j.get("bsdf_prob", "-"), j.get("join_depth_chosen") if j.get("join_depth_chosen") is not None else "-")' "$tmp/run.json")
     rel=$("$exe" compare "$tmp/img.exr" "$ref" | json relmse)
     echo "$name $label seed $seed spp $spp bsdf_prob ${prob:-none} join_depth ${depth:--} relmse $rel"
   done

@@ -88,7 +88,7 @@ constexpr RouletteRule kRoulettes[] = {RouletteRule::Auto, RouletteRule::Sqrt, R
 constexpr const char* kRouletteNames[] = {"auto", "sqrt", "throughput", "vpl (VPL weight window)"};
 
 constexpr int kJoinDepths[] = {ConnectionSettings::kJoinDepthAuto, -1, 2, 1, 0};
-constexpr const char* kJoinDepthNames[] = {"auto (each tried, the best kept)", "every vertex", "up to depth 2",
+constexpr const char* kJoinDepthNames[] = {"auto (every vertex vs up to depth 1, measured)", "every vertex", "up to depth 2",
                                            "up to depth 1", "the camera ray's hit only"};
 
 int joinDepthIndex(int depth) {

@@ -54,7 +54,7 @@ struct ConnectionSettings {
   // (0.82, 0.83), Cornell box 0.94 (0.97, 1.03), cornell_glossy 1.03 (1.11, 1.20), 2 seeds for the last two.
   int joinsPerVertex = 2;
   // The deepest camera vertex that joins (0: the camera ray's hit), or -1: every vertex, or -2
-  // (kJoinDepthAuto): the render tries the depths and keeps the one that pays (join_depth_trial.h). A join's
+  // (kJoinDepthAuto): the render tries -1 and 1 (JoinDepthTrial::kCandidates) and keeps the one that pays. A join's
   // weight leaves out the joins that a limit forbids on either side, so the estimate stays unbiased
   // (LightVertex keeps the terms of the joins that a limit of kMaxJoinDepth or less may allow apart).
   int joinDepth = -1;

@@ -6,20 +6,21 @@
 // trade is a property of the scene, so each candidate depth renders a few whole passes, interleaved
 // after the auto roulette's window has decided, and the depth of least variance x time wins for
 // the rest of the render. The trial's passes of the losing depth stay in the image, so it must be
-// short: two candidates, two passes each. Depth 0 is not one: on the Cornell box it is about as
+// short: two candidates, two passes each (-1, 1, 1, -1). Depth 0 is not one: on the Cornell box it is about as
 // good as depth 1 (1-spp relMSE x cost 0.099 against 0.096), and on door_ajar and two_rooms its
 // trial passes, 4x worse per sample than every vertex's, cost more than a choice could win (a trial
 // of three depths, three passes each, at 22 spp in 10 s: two_rooms 1.4x the relMSE of every vertex).
 // Nor is depth 2: two passes rarely show its rare bright samples, so it won the trial on two_rooms
 // where it loses (32 spp, 3 seeds: 1.26x the relMSE at 0.9x the time).
 //
-// Opt-in, not the default: at 32 spp (3 seeds, README) it gains 4-5 % of relMSE x time on the Cornell
-// box and the glossy box and loses 15 % on door_ajar, where the two passes of depth 1 it keeps are
+// Opt-in, not the default: at 32 spp (3 seeds, README) it gains 4 % of relMSE x time on the Cornell
+// box and loses 15 % on door_ajar, where the two passes of depth 1 it keeps are
 // 2-4x worse per sample; the trial's share of the passes, and so that loss, falls as 1/spp.
 //
 // Every pass is an unbiased estimate whatever its depth (the MIS weights leave out exactly the
 // joins a depth forbids), and the choice depends only on earlier passes, so the image stays
-// unbiased.
+// unbiased. It is not deterministic in the seed, though: the choice rests on measured seconds, so
+// on a near tie a loaded machine or another thread count may choose the other depth.
 //
 // The measure, per candidate: the mean over pixels of its passes' sample variance of luminance,
 // each pixel weighted by 1 / (m^2 + 0.01), m the image of the passes before the trial (relMSE's
@@ -70,7 +71,13 @@ class JoinDepthTrial {
   const std::array<double, kCandidates.size()>& scores() const { return scores_; }
 
  private:
-  static size_t candidateOf(uint64_t pass) { return size_t(pass - kFirstPass) % kCandidates.size(); }
+  // In the order -1, 1, 1, -1: each candidate's mean pass sits at the trial's middle, so the guides and
+  // join choices, which learn between passes, favour neither.
+  static size_t candidateOf(uint64_t pass) {
+    static_assert(kCandidates.size() == 2 && kPassesEach == 2);
+    const size_t i = size_t(pass - kFirstPass);
+    return i == 1 || i == 2 ? 1 : 0;
+  }
   void decide();
 
   // The variance is a median of means over groups of rows: one rare bright sample in one pixel (a

@@ -324,6 +324,11 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
   const RouletteRule rule = settings_.tracer.roulette;
   // VPL connections: fresh light vertices before every pass, for tracers of this refinement only.
   const int joinPaths = settings_.connections.pathsFor(w * h, request.mode);
+  if (joinPaths <= 0) {  // the panel must not show the joins of another mode's film
+    std::lock_guard lock(mutex_);
+    stats_.joinDepth = SessionStats::kNoJoins;
+    stats_.joinDepthTrial = stats_.joinDepthDecided = false;
+  }
   if (joinPaths > 0 && !mine.joins) {
     mine.joins = std::make_unique<LightVertexCache>(settings_.connections);
     if (settings_.connections.joinDepth == ConnectionSettings::kJoinDepthAuto) {
@@ -360,13 +365,13 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
     if (stats_.refineStartSeconds == 0.0) stats_.refineStartSeconds = secondsSince(state.restart);
   }
   while (mine.complete < settings_.maxSpp) {
+    const bool trialPass = mine.joinTrial && JoinDepthTrial::isTrialPass(mine.nextPass);
+    if (trialPass && mine.nextPass == JoinDepthTrial::kFirstPass) mine.joinTrial->start(*mine.film);
     const auto t = Clock::now();
     if (joinPaths > 0) mine.joins->build(scene, settings_.seed, mine.nextPass, joinPaths, settings_.tracer.maxDepth - 1,
                                       settings_.stratifiedSampler);
     const uint64_t index = mine.nextPass++;
-    const bool trialPass = mine.joinTrial && JoinDepthTrial::isTrialPass(index);
     if (mine.joinTrial) mine.joins->setJoinDepth(mine.joinTrial->depthForNext(index));
-    if (trialPass && index == JoinDepthTrial::kFirstPass) mine.joinTrial->start(*mine.film);
     if (trialPass) mine.trialFilm->clear();
     const PassStats pass = renderer->renderPass(trialPass ? *mine.trialFilm : *mine.film, index, &cancel_);
     if (trialPass) {

@@ -171,6 +171,8 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
   for (uint64_t pass = 0;; ++pass) {
     if (!timed && int(pass) >= settings.spp) break;
     if (timed && pass > 0 && stop.load()) break;
+    const bool trialPass = joinTrial && JoinDepthTrial::isTrialPass(pass);
+    if (trialPass && pass == JoinDepthTrial::kFirstPass) joinTrial->start(film);
     // A trial pass's seconds include its light paths: a depth's cost is the whole pass's.
     const auto passStart = Clock::now();
     if (connecting) {
@@ -179,9 +181,7 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
       result.timings.connections += secondsSince(t);
       result.rays += connectionCache.rays();
     }
-    const bool trialPass = joinTrial && JoinDepthTrial::isTrialPass(pass);
     if (joinTrial) connectionCache.setJoinDepth(joinTrial->depthForNext(pass));
-    if (trialPass && pass == JoinDepthTrial::kFirstPass) joinTrial->start(film);
     if (trialPass) trialFilm->clear();
     // The first pass always completes: a budget never leaves an empty image.
     const PassStats stats = renderer->renderPass(trialPass ? *trialFilm : film, pass, pass == 0 ? nullptr : &stop);
@@ -189,6 +189,7 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
       const bool complete = !(timed && stop.load());
       if (complete) joinTrial->record(pass, *trialFilm, secondsSince(passStart));
       film.add(*trialFilm);
+      if (joinTrial->decided()) trialFilm.reset();  // only the trial needs it
     }
     result.rays += stats.rays;
     result.samples += stats.samples;
