@@ -13,8 +13,8 @@
 // Nor is depth 2: two passes rarely show its rare bright samples, so it won the trial on two_rooms
 // where it loses (32 spp, 3 seeds: 1.26x the relMSE at 0.9x the time).
 //
-// Opt-in, not the default: at 32 spp (3 seeds, README) it gains 4 % of relMSE x time on the Cornell
-// box and loses 15 % on door_ajar, where the two passes of depth 1 it keeps are
+// Opt-in, not the default: at 32 spp (3 seeds, README) it gained 4 % of relMSE x time on the Cornell
+// box, at 128 spp nothing beyond the timing noise, and it loses 15 % on door_ajar at 32 spp, where the two passes of depth 1 it keeps are
 // 2-4x worse per sample; the trial's share of the passes, and so that loss, falls as 1/spp.
 //
 // Every pass is an unbiased estimate whatever its depth (the MIS weights leave out exactly the
