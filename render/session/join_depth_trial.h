@@ -14,8 +14,9 @@
 // where it loses (32 spp, 3 seeds: 1.26x the relMSE at 0.9x the time).
 //
 // Opt-in, not the default: at 32 spp (3 seeds, README) it gained 4 % of relMSE x time on the Cornell
-// box, at 128 spp nothing beyond the timing noise, and it loses 15 % on door_ajar at 32 spp, where the two passes of depth 1 it keeps are
-// 2-4x worse per sample; the trial's share of the passes, and so that loss, falls as 1/spp.
+// box, at 128 spp nothing beyond the timing noise, and it loses 15 % on door_ajar at 32 spp, where
+// the two passes of depth 1 it keeps are 2-4x worse per sample; the trial's share of the passes,
+// and so that loss, falls as 1/spp (3-4 % at 128 spp).
 //
 // Every pass is an unbiased estimate whatever its depth (the MIS weights leave out exactly the
 // joins a depth forbids), and the choice depends only on earlier passes, so the image stays
