@@ -365,17 +365,20 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
     if (stats_.refineStartSeconds == 0.0) stats_.refineStartSeconds = secondsSince(state.restart);
   }
   while (mine.complete < settings_.maxSpp) {
-    const bool trialPass = mine.joinTrial && JoinDepthTrial::isTrialPass(mine.nextPass);
-    if (trialPass && mine.nextPass == JoinDepthTrial::kFirstPass) mine.joinTrial->start(*mine.film);
+    // The trial counts complete passes, as the roulette's window does, so that it starts after the
+    // window's last decision even when a mode switch cancelled a pass; a cancelled trial pass is run again.
+    const uint64_t slot = uint64_t(mine.complete);
+    const bool trialPass = mine.joinTrial && JoinDepthTrial::isTrialPass(slot);
+    if (trialPass && slot == JoinDepthTrial::kFirstPass) mine.joinTrial->start(*mine.film);
     const auto t = Clock::now();
     if (joinPaths > 0) mine.joins->build(scene, settings_.seed, mine.nextPass, joinPaths, settings_.tracer.maxDepth - 1,
                                       settings_.stratifiedSampler);
     const uint64_t index = mine.nextPass++;
-    if (mine.joinTrial) mine.joins->setJoinDepth(mine.joinTrial->depthForNext(index));
+    if (mine.joinTrial) mine.joins->setJoinDepth(mine.joinTrial->depthForNext(slot));
     if (trialPass) mine.trialFilm->clear();
     const PassStats pass = renderer->renderPass(trialPass ? *mine.trialFilm : *mine.film, index, &cancel_);
     if (trialPass) {
-      if (!cancelled()) mine.joinTrial->record(index, *mine.trialFilm, secondsSince(t));  // light paths included
+      if (!cancelled()) mine.joinTrial->record(slot, *mine.trialFilm, secondsSince(t));  // light paths included
       mine.film->add(*mine.trialFilm);
     }
     if (mine.joins) {

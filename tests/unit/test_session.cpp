@@ -1,6 +1,7 @@
 // The viewer's progressive session without a window: restarts discard the old view's samples,
 // modes keep their own films, every thread is joined on destruction.
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
@@ -12,6 +13,7 @@
 #include <thread>
 #include "render/film/image_metrics.h"
 #include "render/scene/gltf_loader.h"
+#include "render/session/join_depth_trial.h"
 #include "render/session/progressive_session.h"
 #include "tests/unit/support.h"
 
@@ -101,6 +103,27 @@ TEST(Session, RandomSamplerReachesTheRefiningAndThePreviewPasses) {
     EXPECT_EQ(relMse(c, b), 0.0) << modeName(mode);
     EXPECT_EQ(random.stats().stage, SessionStage::Done) << modeName(mode);
   }
+}
+
+// `--join-depth auto` in the viewer: past the trial's passes the session has decided between the
+// candidate depths and says so; a mode without joins then shows no joins line.
+TEST(Session, JoinDepthTrialDecidesAndAModeWithoutJoinsClearsIt) {
+  const auto scene = cornell();
+  SessionSettings settings = small(SamplingMode::Mis, int(JoinDepthTrial::kLastPass) + 2);
+  settings.connections.joinDepth = ConnectionSettings::kJoinDepthAuto;
+  ProgressiveSession session(scene, defaultCamera(scene->data()), settings);
+  const Image image = finalImage(session);
+  for (const glm::vec3& p : image.pixels) ASSERT_TRUE(std::isfinite(p.x + p.y + p.z));
+  SessionStats stats = session.stats();
+  EXPECT_TRUE(stats.joinDepthTrial);
+  EXPECT_TRUE(stats.joinDepthDecided);
+  EXPECT_TRUE(stats.joinDepth == JoinDepthTrial::kCandidates[0] || stats.joinDepth == JoinDepthTrial::kCandidates[1])
+      << stats.joinDepth;
+  session.setMode(SamplingMode::Brdf);
+  finalImage(session);
+  stats = session.stats();
+  EXPECT_EQ(stats.joinDepth, SessionStats::kNoJoins);
+  EXPECT_FALSE(stats.joinDepthTrial);
 }
 
 TEST(Session, MovesDuringEveryStageStillEndInTheFreshImage) {
