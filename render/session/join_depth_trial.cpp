@@ -6,7 +6,8 @@
 
 namespace vpl {
 
-JoinDepthTrial::JoinDepthTrial(int width, int height) : width_(size_t(std::max(width, 1))), pixels_(size_t(width) * size_t(height)) {
+JoinDepthTrial::JoinDepthTrial(int width, int height)
+    : width_(size_t(std::max(width, 1))), height_(size_t(std::max(height, 0))), pixels_(size_t(width) * size_t(height)) {
   for (size_t c = 0; c < kCandidates.size(); ++c) {
     sum_[c].assign(pixels_, 0.0);
     sum2_[c].assign(pixels_, 0.0);
@@ -21,6 +22,22 @@ void JoinDepthTrial::start(const Film& film) {
     const double m = luminance(image.pixels[i]);
     weight_[i] = 1.0 / (m * m + 0.01);
   }
+}
+
+Film& JoinDepthTrial::beginPass(uint64_t slot, Film& image, LightVertexCache& joins) {
+  joins.setJoinDepth(depthForNext(slot));
+  if (!isTrialPass(slot)) return image;
+  if (slot == kFirstPass) start(image);
+  if (!passFilm_) passFilm_.emplace(int(width_), int(height_));
+  passFilm_->clear();
+  return *passFilm_;
+}
+
+void JoinDepthTrial::endPass(uint64_t slot, Film& image, bool complete, double seconds) {
+  if (!isTrialPass(slot) || !passFilm_) return;
+  if (complete) record(slot, *passFilm_, seconds);
+  image.add(*passFilm_);
+  if (decided_) passFilm_.reset();
 }
 
 int JoinDepthTrial::depthFor(uint64_t pass) const {

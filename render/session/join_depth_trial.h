@@ -33,8 +33,10 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <vector>
 #include "render/film/film.h"
+#include "render/integrator/light_vertex_cache.h"
 
 namespace vpl {
 
@@ -48,6 +50,14 @@ class JoinDepthTrial {
   static constexpr uint64_t kLastPass = kFirstPass + kCandidates.size() * kPassesEach - 1;
 
   JoinDepthTrial(int width, int height);
+
+  // What a render loop calls around pass `slot` (counting complete passes), after the pass's light
+  // vertices are built: sets the depth the joins use and returns the film to render into, the image
+  // itself or, during the trial, a film of the pass's own.
+  Film& beginPass(uint64_t slot, Film& image, LightVertexCache& joins);
+  // After the pass: a complete trial pass is recorded with its seconds (light paths included: a
+  // depth's cost is the whole pass's), and its samples join the image either way.
+  void endPass(uint64_t slot, Film& image, bool complete, double seconds);
 
   // Before the first trial pass: the image so far, whose luminance weighs the pixels.
   void start(const Film& film);
@@ -85,7 +95,8 @@ class JoinDepthTrial {
   // Cornell box's trial pass had one that tripled a candidate's sum) must not decide.
   static constexpr size_t kGroups = 9;
 
-  size_t width_, pixels_;
+  size_t width_, height_, pixels_;
+  std::optional<Film> passFilm_;  // a trial pass's own samples, freed once the trial has decided
   std::vector<double> weight_;  // per pixel: 1 / (m^2 + 0.01), m from start()
   // Per candidate and pixel: the sum and sum of squares of the passes' luminance.
   std::array<std::vector<double>, kCandidates.size()> sum_, sum2_;

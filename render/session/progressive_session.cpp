@@ -64,7 +64,6 @@ struct ProgressiveSession::CameraState {
     std::unique_ptr<FilmLearners> learners;     // what this film's passes teach the guided continuations
     std::unique_ptr<LightVertexCache> joins;    // VPL connections: its choice of vertices learns from this film's passes
     std::unique_ptr<JoinDepthTrial> joinTrial;  // --join-depth auto: which depth this film's passes join to
-    std::unique_ptr<Film> trialFilm;            // a trial pass's own samples
   };
   std::optional<Request> key;
   Clock::time_point restart = Clock::now();
@@ -331,10 +330,7 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
   }
   if (joinPaths > 0 && !mine.joins) {
     mine.joins = std::make_unique<LightVertexCache>(settings_.connections);
-    if (settings_.connections.joinDepth == ConnectionSettings::kJoinDepthAuto) {
-      mine.joinTrial = std::make_unique<JoinDepthTrial>(w, h);
-      mine.trialFilm = std::make_unique<Film>(w, h);
-    }
+    if (settings_.connections.joinDepth == ConnectionSettings::kJoinDepthAuto) mine.joinTrial = std::make_unique<JoinDepthTrial>(w, h);
   }
   std::optional<PathTracer> joinTracer, joinWindowTracer;
   auto refineTracer = [&]() -> const PathTracer& {
@@ -368,19 +364,13 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
     // The trial counts complete passes, as the roulette's window does, so that it starts after the
     // window's last decision even when a mode switch cancelled a pass; a cancelled trial pass is run again.
     const uint64_t slot = uint64_t(mine.complete);
-    const bool trialPass = mine.joinTrial && JoinDepthTrial::isTrialPass(slot);
-    if (trialPass && slot == JoinDepthTrial::kFirstPass) mine.joinTrial->start(*mine.film);
     const auto t = Clock::now();
     if (joinPaths > 0) mine.joins->build(scene, settings_.seed, mine.nextPass, joinPaths, settings_.tracer.maxDepth - 1,
                                       settings_.stratifiedSampler);
     const uint64_t index = mine.nextPass++;
-    if (mine.joinTrial) mine.joins->setJoinDepth(mine.joinTrial->depthForNext(slot));
-    if (trialPass) mine.trialFilm->clear();
-    const PassStats pass = renderer->renderPass(trialPass ? *mine.trialFilm : *mine.film, index, &cancel_);
-    if (trialPass) {
-      if (!cancelled()) mine.joinTrial->record(slot, *mine.trialFilm, secondsSince(t));  // light paths included
-      mine.film->add(*mine.trialFilm);
-    }
+    Film& target = mine.joinTrial ? mine.joinTrial->beginPass(slot, *mine.film, *mine.joins) : *mine.film;
+    const PassStats pass = renderer->renderPass(target, index, &cancel_);
+    if (mine.joinTrial) mine.joinTrial->endPass(slot, *mine.film, !cancelled(), secondsSince(t));
     if (mine.joins) {
       std::lock_guard lock(mutex_);
       stats_.joinDepth = mine.joins->joinDepth();

@@ -157,11 +157,8 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
 
   // --join-depth auto: a few passes of each candidate depth, each into a film of its own.
   std::optional<JoinDepthTrial> joinTrial;
-  std::optional<Film> trialFilm;
-  if (connecting && settings.connections.joinDepth == ConnectionSettings::kJoinDepthAuto) {
+  if (connecting && settings.connections.joinDepth == ConnectionSettings::kJoinDepthAuto)
     joinTrial.emplace(settings.width, settings.height);
-    trialFilm.emplace(settings.width, settings.height);
-  }
 
   const auto renderStart = Clock::now();
   std::atomic<bool> stop{false};
@@ -171,9 +168,6 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
   for (uint64_t pass = 0;; ++pass) {
     if (!timed && int(pass) >= settings.spp) break;
     if (timed && pass > 0 && stop.load()) break;
-    const bool trialPass = joinTrial && JoinDepthTrial::isTrialPass(pass);
-    if (trialPass && pass == JoinDepthTrial::kFirstPass) joinTrial->start(film);
-    // A trial pass's seconds include its light paths: a depth's cost is the whole pass's.
     const auto passStart = Clock::now();
     if (connecting) {
       const auto t = Clock::now();
@@ -181,16 +175,10 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
       result.timings.connections += secondsSince(t);
       result.rays += connectionCache.rays();
     }
-    if (joinTrial) connectionCache.setJoinDepth(joinTrial->depthForNext(pass));
-    if (trialPass) trialFilm->clear();
+    Film& target = joinTrial ? joinTrial->beginPass(pass, film, connectionCache) : film;
     // The first pass always completes: a budget never leaves an empty image.
-    const PassStats stats = renderer->renderPass(trialPass ? *trialFilm : film, pass, pass == 0 ? nullptr : &stop);
-    if (trialPass) {
-      const bool complete = !(timed && stop.load());
-      if (complete) joinTrial->record(pass, *trialFilm, secondsSince(passStart));
-      film.add(*trialFilm);
-      if (joinTrial->decided()) trialFilm.reset();  // only the trial needs it
-    }
+    const PassStats stats = renderer->renderPass(target, pass, pass == 0 ? nullptr : &stop);
+    if (joinTrial) joinTrial->endPass(pass, film, !(timed && stop.load()), secondsSince(passStart));
     result.rays += stats.rays;
     result.samples += stats.samples;
     result.discarded += stats.discarded;

@@ -5,6 +5,7 @@
 #include <functional>
 #include <gtest/gtest.h>
 #include "render/film/film.h"
+#include "render/integrator/light_vertex_cache.h"
 #include "render/sampling/rng.h"
 #include "render/session/join_depth_trial.h"
 
@@ -109,6 +110,29 @@ TEST(JoinDepthTrial, KeepsEveryVertexWithoutAStart) {
   }
   EXPECT_TRUE(trial.decided());
   EXPECT_EQ(trial.chosen(), -1);
+}
+
+// The render loops' side (render_job, progressive_session): each pass joins to the depth of its slot,
+// trial passes render into a film of their own whose samples still reach the image, a pass cut short
+// is not recorded, and the last complete trial pass decides.
+TEST(JoinDepthTrial, PassesRouteTrialSamplesToTheirOwnFilmAndIntoTheImage) {
+  JoinDepthTrial trial(2, 1);
+  LightVertexCache joins{ConnectionSettings{}};
+  Film image(2, 1);
+  const auto fill = [](Film& f, float v) { f.addSample(0, 0, glm::vec3(v)), f.addSample(1, 0, glm::vec3(v)); };
+  for (uint64_t slot = 0; slot <= JoinDepthTrial::kLastPass + 1; ++slot) {
+    joins.setJoinDepth(7);
+    Film& target = trial.beginPass(slot, image, joins);
+    EXPECT_EQ(joins.joinDepth(), trial.depthFor(slot)) << slot;
+    EXPECT_EQ(&target == &image, !JoinDepthTrial::isTrialPass(slot)) << slot;
+    fill(target, float(slot + 1));
+    // The first trial pass is cut short: its samples count in the image, its time and variance do not,
+    // so the trial needs one more pass of that candidate than it gets and decides from the rest.
+    trial.endPass(slot, image, slot != JoinDepthTrial::kFirstPass, 0.5);
+    EXPECT_FLOAT_EQ(image.resolve().pixels[0].x, float(slot + 2) / 2.0f) << slot;  // the mean of 1 ... slot + 1
+  }
+  EXPECT_TRUE(trial.decided());
+  EXPECT_EQ(joins.joinDepth(), trial.chosen());
 }
 
 }  // namespace
