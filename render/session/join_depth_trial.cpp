@@ -3,11 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include "render/core/color.h"
+#include "render/integrator/light_vertex_cache.h"
 
 namespace vpl {
 
 JoinDepthTrial::JoinDepthTrial(int width, int height)
-    : width_(size_t(std::max(width, 1))), height_(size_t(std::max(height, 0))), pixels_(size_t(width) * size_t(height)) {
+    : width_(size_t(std::max(width, 1))), pixels_(size_t(std::max(width, 0)) * size_t(std::max(height, 0))) {
   for (size_t c = 0; c < kCandidates.size(); ++c) {
     sum_[c].assign(pixels_, 0.0);
     sum2_[c].assign(pixels_, 0.0);
@@ -27,14 +28,17 @@ void JoinDepthTrial::start(const Film& film) {
 Film& JoinDepthTrial::beginPass(uint64_t slot, Film& image, LightVertexCache& joins) {
   joins.setJoinDepth(depthForNext(slot));
   if (!isTrialPass(slot)) return image;
-  if (slot == kFirstPass) start(image);
-  if (!passFilm_) passFilm_.emplace(int(width_), int(height_));
+  if (!passFilm_) passFilm_.emplace(image.width(), image.height());  // only if the pass before was skipped
   passFilm_->clear();
   return *passFilm_;
 }
 
 void JoinDepthTrial::endPass(uint64_t slot, Film& image, bool complete, double seconds) {
-  if (!isTrialPass(slot) || !passFilm_) return;
+  if (slot + 1 == kFirstPass && complete) {
+    start(image);
+    passFilm_.emplace(image.width(), image.height());
+  }
+  if (!isTrialPass(slot)) return;
   if (complete) record(slot, *passFilm_, seconds);
   image.add(*passFilm_);
   if (decided_) passFilm_.reset();

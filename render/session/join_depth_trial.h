@@ -36,9 +36,10 @@
 #include <optional>
 #include <vector>
 #include "render/film/film.h"
-#include "render/integrator/light_vertex_cache.h"
 
 namespace vpl {
+
+class LightVertexCache;
 
 class JoinDepthTrial {
  public:
@@ -56,19 +57,19 @@ class JoinDepthTrial {
   // itself or, during the trial, a film of the pass's own.
   Film& beginPass(uint64_t slot, Film& image, LightVertexCache& joins);
   // After the pass: a complete trial pass is recorded with its seconds (light paths included: a
-  // depth's cost is the whole pass's), and its samples join the image either way.
+  // depth's cost is the whole pass's), and its samples join the image either way. The complete pass
+  // before the trial prepares it (start() and the pass film), so that neither is timed as a candidate's.
   void endPass(uint64_t slot, Film& image, bool complete, double seconds);
 
   // Before the first trial pass: the image so far, whose luminance weighs the pixels.
   void start(const Film& film);
-  // Whether pass `pass` (0-based) is one of the trial's: render it into a film of its own, hand that
-  // to record(), then add it to the image.
+  // Whether pass `pass` (0-based) is one of the trial's (beginPass/endPass route it).
   static bool isTrialPass(uint64_t pass) { return pass >= kFirstPass && pass <= kLastPass; }
   // The depth pass `pass` joins to: the candidates in turn during the trial, the winner after it,
   // every vertex before it.
   int depthFor(uint64_t pass) const;
   // The same, for the pass about to start: past the trial, decides from what was recorded if the
-  // last trial pass never completed (a viewer's pass cancelled by a mode switch).
+  // last trial pass was never recorded (a test or caller that skipped it).
   int depthForNext(uint64_t pass) {
     if (pass > kLastPass && !decided_) decide();
     return depthFor(pass);
@@ -95,7 +96,7 @@ class JoinDepthTrial {
   // Cornell box's trial pass had one that tripled a candidate's sum) must not decide.
   static constexpr size_t kGroups = 9;
 
-  size_t width_, height_, pixels_;
+  size_t width_, pixels_;
   std::optional<Film> passFilm_;  // a trial pass's own samples, freed once the trial has decided
   std::vector<double> weight_;  // per pixel: 1 / (m^2 + 0.01), m from start()
   // Per candidate and pixel: the sum and sum of squares of the passes' luminance.

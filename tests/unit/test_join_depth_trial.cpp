@@ -113,26 +113,40 @@ TEST(JoinDepthTrial, KeepsEveryVertexWithoutAStart) {
 }
 
 // The render loops' side (render_job, progressive_session): each pass joins to the depth of its slot,
-// trial passes render into a film of their own whose samples still reach the image, a pass cut short
-// is not recorded, and the last complete trial pass decides.
+// trial passes render into a film of their own whose samples still reach the image, and the last
+// complete trial pass decides. As in the viewer, the first trial pass is cut short (a mode switch) and
+// run again: its samples count in the image, but neither its seconds nor its variance nor the pixel
+// weights (set when the pass before the trial completes) may see them.
 TEST(JoinDepthTrial, PassesRouteTrialSamplesToTheirOwnFilmAndIntoTheImage) {
+  static_assert(JoinDepthTrial::kFirstPass == 4 && JoinDepthTrial::kLastPass == 7);
   JoinDepthTrial trial(2, 1);
   LightVertexCache joins{ConnectionSettings{}};
   Film image(2, 1);
-  const auto fill = [](Film& f, float v) { f.addSample(0, 0, glm::vec3(v)), f.addSample(1, 0, glm::vec3(v)); };
-  for (uint64_t slot = 0; slot <= JoinDepthTrial::kLastPass + 1; ++slot) {
+  double sum = 0.0;
+  int count = 0;
+  const auto runPass = [&](uint64_t slot, float value, bool complete, double seconds) {
     joins.setJoinDepth(7);
     Film& target = trial.beginPass(slot, image, joins);
     EXPECT_EQ(joins.joinDepth(), trial.depthFor(slot)) << slot;
     EXPECT_EQ(&target == &image, !JoinDepthTrial::isTrialPass(slot)) << slot;
-    fill(target, float(slot + 1));
-    // The first trial pass is cut short: its samples count in the image, its time and variance do not,
-    // so the trial needs one more pass of that candidate than it gets and decides from the rest.
-    trial.endPass(slot, image, slot != JoinDepthTrial::kFirstPass, 0.5);
-    EXPECT_FLOAT_EQ(image.resolve().pixels[0].x, float(slot + 2) / 2.0f) << slot;  // the mean of 1 ... slot + 1
-  }
-  EXPECT_TRUE(trial.decided());
-  EXPECT_EQ(joins.joinDepth(), trial.chosen());
+    target.addSample(0, 0, glm::vec3(value));
+    target.addSample(1, 0, glm::vec3(value));
+    trial.endPass(slot, image, complete, seconds);
+    sum += value, ++count;
+    EXPECT_NEAR(image.resolve().pixels[0].x, sum / count, 1e-4) << slot;
+    EXPECT_EQ(trial.decided(), slot >= JoinDepthTrial::kLastPass) << slot;
+  };
+  for (uint64_t slot = 0; slot < JoinDepthTrial::kFirstPass; ++slot) runPass(slot, float(slot + 1), true, 0.5);
+  runPass(4, 1000.0f, false, 100.0);  // cut short
+  // Candidate -1 (slots 4 and 7) draws 1 and 5, candidate 1 (slots 5 and 6) 2 and 3.
+  const float values[] = {1.0f, 2.0f, 3.0f, 5.0f};
+  for (uint64_t slot = JoinDepthTrial::kFirstPass; slot <= JoinDepthTrial::kLastPass + 1; ++slot)
+    runPass(slot, slot <= JoinDepthTrial::kLastPass ? values[slot - 4] : 4.0f, true, 0.5);
+  EXPECT_EQ(trial.chosen(), 1);
+  EXPECT_EQ(joins.joinDepth(), 1);
+  // Variance (5 - 1)^2 / 2 = 8, weight 1 / (2.5^2 + 0.01) from the mean of the passes 1 ... 4, 0.5 s per pass.
+  EXPECT_NEAR(trial.scores()[0], 8.0 / 6.26 * 0.5, 1e-6);
+  EXPECT_NEAR(trial.scores()[1], 0.5 / 6.26 * 0.5, 1e-6);
 }
 
 }  // namespace
