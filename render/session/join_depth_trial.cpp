@@ -27,8 +27,7 @@ void JoinDepthTrial::start(const Film& film) {
 
 Film& JoinDepthTrial::beginPass(uint64_t slot, Film& image, LightVertexCache& joins) {
   joins.setJoinDepth(depthForNext(slot));
-  if (!isTrialPass(slot)) return image;
-  if (!passFilm_) passFilm_.emplace(image.width(), image.height());  // only if the pass before was skipped
+  if (!isTrialPass(slot) || !passFilm_) return image;  // no film: the trial was never prepared
   passFilm_->clear();
   return *passFilm_;
 }
@@ -38,7 +37,7 @@ void JoinDepthTrial::endPass(uint64_t slot, Film& image, bool complete, double s
     start(image);
     passFilm_.emplace(image.width(), image.height());
   }
-  if (!isTrialPass(slot)) return;
+  if (!isTrialPass(slot) || !passFilm_) return;
   if (complete) record(slot, *passFilm_, seconds);
   image.add(*passFilm_);
   if (decided_) passFilm_.reset();

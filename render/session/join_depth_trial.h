@@ -54,7 +54,7 @@ class JoinDepthTrial {
 
   // What a render loop calls around pass `slot` (counting complete passes), after the pass's light
   // vertices are built: sets the depth the joins use and returns the film to render into, the image
-  // itself or, during the trial, a film of the pass's own.
+  // itself or, during a prepared trial (endPass), a film of the pass's own.
   Film& beginPass(uint64_t slot, Film& image, LightVertexCache& joins);
   // After the pass: a complete trial pass is recorded with its seconds (light paths included: a
   // depth's cost is the whole pass's), and its samples join the image either way. The complete pass
