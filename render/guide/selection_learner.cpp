@@ -45,11 +45,13 @@ void SelectionLearner::update() {
     for (size_t k = 1; k < kCount; ++k)
       if (moment_[c][k] < moment_[c][best]) best = k;
     // The most BSDF whose moment is within the margin of the least (see kStratifiedMargin).
+    const double least = moment_[c][best];
     for (size_t k = kCount - 1; k > best; --k)
-      if (moment_[c][k] <= (1.0 + kStratifiedMargin) * moment_[c][best]) {
+      if (moment_[c][k] <= (1.0 + kStratifiedMargin) * least) {
         best = k;
         break;
       }
+    if (moment_[c][kCount - 1] <= (1.0 + kBsdfOnlyMargin) * least) best = kCount - 1;  // see kBsdfOnlyMargin
     if (std::isfinite(moment_[c][best])) probability_[c] = kCandidates[best];
   }
 }

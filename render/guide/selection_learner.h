@@ -17,7 +17,10 @@
 // The second moment of independent samples misses what stratification gains, and that favours the
 // BSDF's share: its directions are a stratified set over a smooth lobe. Taking the least moment
 // chose the guide at 0.17 on the Cornell box and lost 6 % per sample there, so the choice is the
-// candidate with the most BSDF whose moment is within kStratifiedMargin of the least (README).
+// candidate with the most BSDF whose moment is within kStratifiedMargin of the least, and the BSDF
+// alone wherever its moment is within kBsdfOnlyMargin of the least: any guide share splits the
+// pixel's stratified points between two strategies, each then stratified like fewer samples
+// (docs/measurements/stratification.md).
 //
 // Threads: each tile of a pass writes its own log (TileLog) and nothing else; update() reads them
 // all, in tile order, between passes, so the choice does not depend on thread count or schedule.
@@ -40,6 +43,12 @@ class SelectionLearner {
   // measured neutral (within 2 % per sample) on four scenes and 0.85x the relMSE on cornell_glossy;
   // 0 lost 6 % on the Cornell box, 25 % gave back half of cornell_glossy's gain.
   static constexpr double kStratifiedMargin = 0.1;
+  // How much more second moment the BSDF alone (candidate 1) may have and still be chosen. On the
+  // Cornell box (64 spp, seeds 1-4) a mixture gained 0.477x per sample from stratification where
+  // brdf gained 0.469x; with 0.25 mis gained 0.458x and its error fell 1.4 %, while cornell_glossy,
+  // two_rooms and door_ajar moved within their seeds' noise (-1 % to +1.5 %); 0.15 changed too few
+  // cache points (0.474x), 0.4 no more than 0.25 elsewhere.
+  static constexpr double kBsdfOnlyMargin = 0.25;
 
   class TileLog {
    public:
