@@ -44,10 +44,10 @@ class SelectionLearner {
   // 0 lost 6 % on the Cornell box, 25 % gave back half of cornell_glossy's gain.
   static constexpr double kStratifiedMargin = 0.1;
   // How much more second moment the BSDF alone (candidate 1) may have and still be chosen. On the
-  // Cornell box (64 spp, seeds 1-4) a mixture gained 0.477x per sample from stratification where
+  // Cornell box (64 spp, seeds 1-4) a mixture gained 0.476x per sample from stratification where
   // brdf gained 0.469x; with 0.25 mis gained 0.458x and its error fell 1.4 %, while cornell_glossy,
-  // two_rooms and door_ajar moved within their seeds' noise (-1 % to +1.5 %); 0.15 changed too few
-  // cache points (0.474x), 0.4 no more than 0.25 elsewhere.
+  // two_rooms and door_ajar moved within their seeds' noise (-0.3 %, -0.6 %, -0.6 %); 0.15 changed
+  // too few cache points (0.473x), 0.4 no more than 0.25 elsewhere.
   static constexpr double kBsdfOnlyMargin = 0.25;
 
   class TileLog {
