@@ -8,7 +8,8 @@
 # For every scene in SCENES (cornell_box door_ajar), spp and seed: Cycles, then vplview in each of
 # MODES (brdf mis), all at the same spp, scored with `vplview compare` against that reference.
 # Writes OUT_DIR/equal_spp_SPP.csv and prints a Markdown table of relMSE ratios (vplview ÷ Cycles).
-# Environment: SEEDS ("1 2"), THREADS (2), MAX_DEPTH (32), CYCLES_RENDER.
+# Environment: SEEDS ("1 2"), THREADS (2), MAX_DEPTH (32), CYCLES_RENDER, REF_MODE (brdf: the reference's mode, as
+# bench/vs_cycles.sh names it; e.g. REF_MODE=mis takes ref_SCENE_*_mis.exr).
 set -euo pipefail
 build=$(cd "${1:?usage: vs_cycles_equal_spp.sh BUILD_DIR OUT_DIR [SPP...]}" && pwd)
 out=$(cd "${2:?usage: vs_cycles_equal_spp.sh BUILD_DIR OUT_DIR [SPP...]}" && pwd)
@@ -18,7 +19,7 @@ here=$(cd "$(dirname "$0")/.." && pwd)
 exe=$build/vplview
 cycles=${CYCLES_RENDER:-$here/../shared/tools/cycles/cycles-render}
 SCENES=${SCENES:-cornell_box door_ajar}; MODES=${MODES:-brdf mis}
-SEEDS=${SEEDS:-1 2}; THREADS=${THREADS:-2}; MAX_DEPTH=${MAX_DEPTH:-32}
+SEEDS=${SEEDS:-1 2}; THREADS=${THREADS:-2}; MAX_DEPTH=${MAX_DEPTH:-32}; REF_MODE=${REF_MODE:-brdf}
 [ -x "$exe" ] || { echo "vs_cycles_equal_spp: no $exe" >&2; exit 2; }
 [ -x "$cycles" ] || { echo "vs_cycles_equal_spp: no $cycles (set CYCLES_RENDER)" >&2; exit 2; }
 for n in $counts; do [[ $n =~ ^[1-9][0-9]*$ ]] || { echo "vs_cycles_equal_spp: '$n' is not a sample count" >&2; exit 2; }; done
@@ -29,7 +30,8 @@ echo "scene,spp,renderer,mode,seed,seconds,relmse" > "$csv"
 for name in $SCENES; do
   scene=$here/scenes/$name.gltf
   if [ "$name" = cornell_box ]; then W=256 H=256; else W=320 H=240; fi
-  ref=$(ls "$out"/ref_"${name}"_*_${W}x${H}_*spp_d${MAX_DEPTH}.exr 2>/dev/null | head -1)
+  suffix=; [ "$REF_MODE" = brdf ] || suffix=_$REF_MODE
+  ref=$(ls "$out"/ref_"${name}"_*_${W}x${H}_*spp_d${MAX_DEPTH}${suffix}.exr 2>/dev/null | head -1)
   [ -n "$ref" ] || { echo "vs_cycles_equal_spp: no reference for $name in $out (run bench/vs_cycles.sh first)" >&2; exit 2; }
   for n in $counts; do
     for seed in $SEEDS; do
