@@ -22,6 +22,7 @@ SCENES=${SCENES:-cornell_box door_ajar}; MODES=${MODES:-brdf mis}
 SEEDS=${SEEDS:-1 2}; THREADS=${THREADS:-2}; MAX_DEPTH=${MAX_DEPTH:-32}; REF_MODE=${REF_MODE:-brdf}
 [ -x "$exe" ] || { echo "vs_cycles_equal_spp: no $exe" >&2; exit 2; }
 [ -x "$cycles" ] || { echo "vs_cycles_equal_spp: no $cycles (set CYCLES_RENDER)" >&2; exit 2; }
+refs=()
 for n in $counts; do [[ $n =~ ^[1-9][0-9]*$ ]] || { echo "vs_cycles_equal_spp: '$n' is not a sample count" >&2; exit 2; }; done
 . "$here/bench/lib.sh"
 csv=$out/equal_spp_${counts// /_}.csv
@@ -33,6 +34,7 @@ for name in $SCENES; do
   suffix=; [ "$REF_MODE" = brdf ] || suffix=_$REF_MODE
   ref=$(ls "$out"/ref_"${name}"_*_${W}x${H}_*spp_d${MAX_DEPTH}${suffix}.exr 2>/dev/null | head -1)
   [ -n "$ref" ] || { echo "vs_cycles_equal_spp: no reference for $name in $out (run bench/vs_cycles.sh first)" >&2; exit 2; }
+  refs+=("$name: $(basename "$ref")")
   for n in $counts; do
     for seed in $SEEDS; do
       img=$out/spp_${name}_${n}_cycles_seed$seed.exr
@@ -49,7 +51,7 @@ for name in $SCENES; do
   done
 done
 
-python3 - "$csv" "$MODES" <<'PY'
+python3 - "$csv" "$MODES" "${refs[@]}" <<'PY'
 import csv, sys
 from statistics import mean
 rows = list(csv.DictReader(open(sys.argv[1])))
@@ -65,5 +67,6 @@ for scene, n in keys:
     rel = [f"**{mean(float(r['relmse']) for r in g('vplview', m)) / crel:.2f}**" for m in modes]
     sec = [f"{mean(float(r['seconds']) for r in g('vplview', m)) / csec:.2f}" for m in modes]
     print(f"| {scene} | {n} | {crel:.4g} | " + " | ".join(rel) + " | " + " | ".join(sec) + " |")
-print("\nMeans over seeds; relMSE (DESIGN.md §4) against the cached 4096-spp vplview reference of bench/vs_cycles.sh.")
+print("\nMeans over seeds; relMSE (DESIGN.md §4) against the cached vplview references of bench/vs_cycles.sh (" +
+      "; ".join(sys.argv[3:]) + "). Seconds are whole renders; quote them only from an idle machine.")
 PY
