@@ -15,6 +15,9 @@ scene_file() {
 # A scene's content hash (its .bin too, when there is one): the key of cached references.
 scene_hash() { local bin=${1%.*}.bin; cat "$1" $([ -f "$bin" ] && echo "$bin") | sha1sum | cut -c1-10; }
 
+# The end of a reference's name before .exr: nothing for brdf's, _MODE for another mode's.
+ref_suffix() { [ "${1:-brdf}" = brdf ] || echo "_$1"; }
+
 # The path of a scene's converged reference (`vplview reference`, brdf unless MODE is given), made on
 # first use and cached in OUT as ref_NAME_HASH_WxH_SPPspp_dDEPTH[_MODE].exr, so that a changed scene never
 # reuses an old one. A guided mode converges to the same image (the mode-agreement tests) with far less
@@ -22,9 +25,7 @@ scene_hash() { local bin=${1%.*}.bin; cat "$1" $([ -f "$bin" ] && echo "$bin") |
 # Usage: ref=$(cached_reference EXE SCENE_FILE NAME OUT W H SPP DEPTH THREADS [MODE]); progress goes to stderr.
 cached_reference() {
   local exe=$1 scene=$2 name=$3 out=$4 w=$5 h=$6 spp=$7 depth=$8 threads=$9 mode=${10:-brdf}
-  local suffix=
-  [ "$mode" = brdf ] || suffix=_$mode
-  local ref=$out/ref_${name}_$(scene_hash "$scene")_${w}x${h}_${spp}spp_d${depth}${suffix}.exr
+  local ref=$out/ref_${name}_$(scene_hash "$scene")_${w}x${h}_${spp}spp_d${depth}$(ref_suffix "$mode").exr
   if [ ! -f "$ref" ]; then
     echo "$(date -Is) $name: $mode reference, $spp spp, depth $depth (cached as $(basename "$ref"))" >&2
     "$exe" reference "$scene" --mode "$mode" --spp "$spp" --width "$w" --height "$h" --threads "$threads" \

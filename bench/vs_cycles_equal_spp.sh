@@ -22,17 +22,16 @@ SCENES=${SCENES:-cornell_box door_ajar}; MODES=${MODES:-brdf mis}
 SEEDS=${SEEDS:-1 2}; THREADS=${THREADS:-2}; MAX_DEPTH=${MAX_DEPTH:-32}; REF_MODE=${REF_MODE:-brdf}
 [ -x "$exe" ] || { echo "vs_cycles_equal_spp: no $exe" >&2; exit 2; }
 [ -x "$cycles" ] || { echo "vs_cycles_equal_spp: no $cycles (set CYCLES_RENDER)" >&2; exit 2; }
-refs=()
 for n in $counts; do [[ $n =~ ^[1-9][0-9]*$ ]] || { echo "vs_cycles_equal_spp: '$n' is not a sample count" >&2; exit 2; }; done
 . "$here/bench/lib.sh"
 csv=$out/equal_spp_${counts// /_}.csv
 echo "scene,spp,renderer,mode,seed,seconds,relmse" > "$csv"
+refs=()  # "scene: reference file" for the table's footnote
 
 for name in $SCENES; do
   scene=$here/scenes/$name.gltf
   if [ "$name" = cornell_box ]; then W=256 H=256; else W=320 H=240; fi
-  suffix=; [ "$REF_MODE" = brdf ] || suffix=_$REF_MODE
-  ref=$(ls "$out"/ref_"${name}"_*_${W}x${H}_*spp_d${MAX_DEPTH}${suffix}.exr 2>/dev/null | head -1)
+  ref=$(ls "$out"/ref_"${name}"_*_${W}x${H}_*spp_d${MAX_DEPTH}$(ref_suffix "$REF_MODE").exr 2>/dev/null | head -1)
   [ -n "$ref" ] || { echo "vs_cycles_equal_spp: no reference for $name in $out (run bench/vs_cycles.sh first)" >&2; exit 2; }
   refs+=("$name: $(basename "$ref")")
   for n in $counts; do

@@ -87,8 +87,8 @@ Accel::Accel(const SceneData& scene) {
   rtcSetDeviceErrorFunction(device_, embreeError, &error_);
   scene_ = rtcNewScene(device_);
   // Embree's default (medium) quality, not high: high's spatial splits traced no faster on any scene here, and on the
-  // million-triangle spheres they cost the first image (whole process at 1 spp 0.62x the time with medium, at 48 spp
-  // 0.74x; paired runs, docs/measurements/first_image.md).
+  // million-triangle spheres they cost the first image (whole process at 1 spp 0.53-0.62x the time with medium, at 48
+  // spp 0.74x; paired runs, docs/measurements/first_image.md).
   rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_MEDIUM);
 
   for (size_t m = 0; m < scene.meshes.size(); ++m) {
