@@ -3,11 +3,12 @@
 
   python3 make_scenes.py                  # the committed small scenes, into this folder
   python3 make_scenes.py --out DIR        # every scene, into DIR
-  python3 make_scenes.py --interior-only --out DIR   # the large interior (built by CMake)
+  python3 make_scenes.py --interior-only --out DIR   # the large interior and skylit hall (built by CMake)
 
 Scenes: cornell_box (the viewer's default), cornell_glossy, two_rooms (light in one room, camera in
 the other), door_ajar (light only behind a door open 15 degrees, camera in the other room),
-interior.glb (a sun-lit hall of more than 100K triangles, a Sponza stand-in).
+interior.glb (a sun-lit hall of more than 100K triangles, a Sponza stand-in), skylit_hall.glb (the
+same hall, matte, lit through its skylights by an emitting panel: a large scene Cycles maps exactly).
 Units are metres, +Y up. Punctual intensities: candela / lux; emission: nits (emissive strength).
 """
 import argparse
@@ -218,6 +219,7 @@ def write_glb(path, doc_and_blob):
 # scenes
 
 WHITE, RED, GREEN = (0.725, 0.71, 0.68), (0.63, 0.065, 0.05), (0.14, 0.45, 0.091)
+SKY_PANEL_STRENGTH = 12.0  # nits: the skylit hall's panel
 
 
 def cornell(glossy):
@@ -340,13 +342,15 @@ def door_ajar(strength=None):
                       ((4.0, 1.5, -1.7), (0.0, 1.0, 0.3), math.radians(60.0)))
 
 
-def interior():
-    """A hall with colonnades, arches, a gallery and furniture, lit by a sun through roof openings."""
-    mats = [material("stone", (0.62, 0.58, 0.52), lambert=True), material("floor", (0.55, 0.5, 0.45), roughness=0.6),
-            material("wood", (0.45, 0.28, 0.15), roughness=0.5), material("red_cloth", (0.6, 0.12, 0.1), lambert=True),
-            material("plaster", (0.85, 0.83, 0.78), lambert=True)]
-    X, Z, H = 10.0, 5.0, 8.0
-    stone, floor, wood, cloth, plaster = Mesh("columns", 0), Mesh("floor", 1), Mesh("furniture", 2), Mesh("banners", 3), Mesh("walls", 4)
+HALL_SIZE = (10.0, 5.0, 8.0)  # half length (x), half width (z), height (y)
+HALL_CAMERA = ((-9.0, 1.7, -3.8), (4.0, 3.0, 1.5), math.radians(65.0))
+
+
+def hall_meshes():
+    """The hall of the interior: colonnades, arches, a gallery and furniture under a roof with skylights."""
+    stone, floor, wood, cloth, plaster = (Mesh("columns", 0), Mesh("floor", 1), Mesh("furniture", 2), Mesh("banners", 3),
+                                          Mesh("walls", 4))
+    X, Z, H = HALL_SIZE
     floor.quad((-X, 0, Z), (X, 0, Z), (X, 0, -Z), (-X, 0, -Z))
     plaster.quad((-X, 0, -Z), (X, 0, -Z), (X, H, -Z), (-X, H, -Z))
     plaster.quad((X, 0, Z), (-X, 0, Z), (-X, H, Z), (X, H, Z))
@@ -389,6 +393,14 @@ def interior():
                 for lx in (-0.18, 0.18):
                     for lz in (-0.18, 0.18):
                         wood.box((xc + dx + lx - 0.02, 0.0, dz + lz - 0.02), (xc + dx + lx + 0.02, 0.42, dz + lz + 0.02))
+    return [floor, plaster, stone, wood, cloth]
+
+
+def interior():
+    """The hall lit by a sun through its roof openings, with a glossy floor and furniture."""
+    mats = [material("stone", (0.62, 0.58, 0.52), lambert=True), material("floor", (0.55, 0.5, 0.45), roughness=0.6),
+            material("wood", (0.45, 0.28, 0.15), roughness=0.5), material("red_cloth", (0.6, 0.12, 0.1), lambert=True),
+            material("plaster", (0.85, 0.83, 0.78), lambert=True)]
     sun_dir = norm((-0.2, -1.0, -0.35))
     # A directional light's node points its -Z along the direction of travel.
     f = sun_dir
@@ -396,8 +408,25 @@ def interior():
     u = cross(r, f)
     sun_node = {"name": "sun", "matrix": [r[0], r[1], r[2], 0, u[0], u[1], u[2], 0, -f[0], -f[1], -f[2], 0, 0, 20, 0, 1]}
     sun = ({"type": "directional", "name": "sun", "color": [1.0, 0.95, 0.85], "intensity": 12.0}, sun_node)
-    return build_gltf([floor, plaster, stone, wood, cloth], mats,
-                      ((-9.0, 1.7, -3.8), (4.0, 3.0, 1.5), math.radians(65.0)), lights=[sun])
+    return build_gltf(hall_meshes(), mats, HALL_CAMERA, lights=[sun])
+
+
+def skylit_hall():
+    """The interior's hall in materials and light that Cycles maps exactly (tools/cycles/README.md): every
+    surface Lambertian (the interior's glossy floor and furniture turn matte), and instead of the sun an
+    emitting panel 1 m above the roof that shines down (one-sided, black base colour), into the hall only
+    through the skylights. Most of the hall sees light that has bounced off the floor below them: the
+    large-scene row of the comparison with Cycles (bench/vs_cycles.sh)."""
+    mats = [material("stone", (0.62, 0.58, 0.52), lambert=True), material("floor", (0.55, 0.5, 0.45), lambert=True),
+            material("wood", (0.45, 0.28, 0.15), lambert=True), material("red_cloth", (0.6, 0.12, 0.1), lambert=True),
+            material("plaster", (0.85, 0.83, 0.78), lambert=True),
+            material("sky_panel", (0.0, 0.0, 0.0), emissive=(1.0, 0.97, 0.92), strength=SKY_PANEL_STRENGTH, lambert=True,
+                     double_sided=False)]
+    X, _, H = HALL_SIZE
+    panel = Mesh("sky_panel", 5)
+    y = H + 1.0
+    panel.quad((-X + 1.0, y, -2.0), (X - 1.0, y, -2.0), (X - 1.0, y, 2.0), (-X + 1.0, y, 2.0))  # its normal points down
+    return build_gltf(hall_meshes() + [panel], mats, HALL_CAMERA)
 
 
 def main():
@@ -415,6 +444,7 @@ def main():
         write_gltf(out, "door_ajar", door_ajar())
     if args.interior_only or args.out:
         write_glb(os.path.join(out, "interior.glb"), interior())
+        write_glb(os.path.join(out, "skylit_hall.glb"), skylit_hall())
 
 
 if __name__ == "__main__":
