@@ -209,6 +209,10 @@ void setPreviewBudgetsToOne(RenderJobSettings& s) {
 
 std::string sourceDir() { return VPLVIEW_SOURCE_DIR; }
 std::string sharedDir() { return VPLVIEW_SHARED_DIR; }
+std::string builtInScene(const std::string& file) {
+  const bool generated = std::filesystem::path(file).extension() == ".glb";
+  return (generated ? std::string(VPLVIEW_BINARY_DIR) : sourceDir()) + "/scenes/" + file;
+}
 
 std::string sharedScene(const std::string& relativePath) {
   const std::filesystem::path p = std::filesystem::path(sharedDir()) / "scenes" / relativePath;

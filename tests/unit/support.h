@@ -47,6 +47,9 @@ void setPreviewBudgetsToOne(RenderJobSettings& settings);
 
 std::string sourceDir();
 std::string sharedDir();
+// Path of a built-in scene by its file name: scenes/NAME.gltf in the source tree, NAME.glb where the
+// build generates it (the interior and the skylit hall, target interior_scene).
+std::string builtInScene(const std::string& file);
 // Path of a scene in ../shared/scenes, or "" (and GTEST_SKIP from the caller) when absent.
 std::string sharedScene(const std::string& relativePath);
 

@@ -18,16 +18,11 @@ constexpr int kWidth = 16, kHeight = 12, kMaxDepth = 8;
 // Few pixels with many samples each: a per-pixel bias stands out of less noise.
 constexpr int kBatches = 16, kSpp = 256;
 
-std::string scenePath(const std::string& scene) {
-  if (scene == "interior.glb") return std::string(VPLVIEW_BINARY_DIR) + "/scenes/interior.glb";
-  return test::sourceDir() + "/scenes/" + scene;
-}
-
 RenderJobSettings settings(const std::string& scene, SamplingMode mode, int spp, uint64_t seed,
                            int guidedVertices = GuideSettings{}.guidedVertices,
                            RouletteRule roulette = RouletteRule::Sqrt, int connectPaths = -1) {
   RenderJobSettings s;
-  s.scenePath = scenePath(scene);
+  s.scenePath = test::builtInScene(scene);
   s.mode = mode;
   s.width = kWidth;
   s.height = kHeight;
@@ -96,7 +91,7 @@ class GuidedModes : public ::testing::TestWithParam<Case> {};
 
 TEST_P(GuidedModes, AgreeWithBsdfSamplingPixelByPixel) {
   const Case c = GetParam();
-  const std::string path = scenePath(c.scene);
+  const std::string path = test::builtInScene(c.scene);
   if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " is not built (target interior_scene)";
   const SceneData data = loadGltf(path);
   const test::BatchEstimate reference =
@@ -171,7 +166,7 @@ INSTANTIATE_TEST_SUITE_P(
 // in a tenth of the pixels, or 3 % brighter in alternate rows and darker in the others by as much
 // (which leaves the image mean unchanged), it fails.
 TEST(PixelAgreement, SeesABiasInSomePixelsOrOneThatCancelsOut) {
-  const SceneData data = loadGltf(scenePath("cornell_box.gltf"));
+  const SceneData data = loadGltf(test::builtInScene("cornell_box.gltf"));
   const RenderJobSettings s = settings("cornell_box.gltf", SamplingMode::Brdf, kSpp, 0);
   std::vector<Image> a, b;
   for (int i = 0; i < kBatches; ++i) {
@@ -210,7 +205,7 @@ TEST(PixelAgreement, SeesABiasInSomePixelsOrOneThatCancelsOut) {
 // better than the first ones, so the spread may fall faster (measured: uniform 7.0-9.6, learned
 // 6.8-12.6), up to 20.
 TEST(GuidedModes, SpreadBetweenSeedsFallsAsOneOverSpp) {
-  const SceneData data = loadGltf(scenePath("two_rooms.gltf"));
+  const SceneData data = loadGltf(test::builtInScene("two_rooms.gltf"));
   for (const bool learnChoice : {false, true}) {
     for (SamplingMode mode : {SamplingMode::Mis, SamplingMode::Metropolis, SamplingMode::Mixture}) {
       auto spread = [&](int spp) {

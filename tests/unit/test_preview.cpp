@@ -98,8 +98,7 @@ double medianRelativeSquaredError(const Image& image, const Image& reference) {
 // mean z^2 up to 1.75), and the relMSE's ratio ranged over 2.7-16 between scenes.
 TEST(Preview, FirstPassesConvergeToTheManyPassLimit) {
   for (const std::string scene : {"cornell_box.gltf", "cornell_glossy.gltf", "two_rooms.gltf", "interior.glb"}) {
-    const std::string path = scene == "interior.glb" ? std::string(VPLVIEW_BINARY_DIR) + "/scenes/interior.glb"
-                                                     : test::sourceDir() + "/scenes/" + scene;
+    const std::string path = test::builtInScene(scene);
     if (!std::filesystem::exists(path)) {
       std::printf("%s is not built: skipped\n", path.c_str());
       continue;

@@ -7,15 +7,22 @@
 # error from their spread. Refused (exit 2, no exact counterpart): cornell_glossy (dielectric
 # glossy layers, metallic 0 with specularFactor 1) and the generated interior (the same).
 # door_ajar maps but is not used (see the test's header).
-# Usage, from the repository root: tests/data/cycles/make_references.sh  (1-2 min for cornell_box,
-# about 6 for two_rooms, on 2 idle cores; needs `apt-get install blender python3-numpy`).
+# Usage, from the repository root: tests/data/cycles/make_references.sh [BUILD_DIR] [SCENE...]
+# (default: build, every scene below; BUILD_DIR holds the generated scenes/skylit_hall.glb). 1-2 min
+# for cornell_box, about 6 for two_rooms and 5 for skylit_hall, on 2 idle cores; needs
+# `apt-get install blender python3-numpy`.
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/../../.." && pwd)
+build=${1:-$repo/build}
+shift || true
 tool=$repo/../shared/tools/cycles/cycles-render
 out=$repo/tests/data/cycles
-for scene in cornell_box two_rooms; do
+for scene in ${*:-cornell_box two_rooms skylit_hall}; do
+  file=$repo/scenes/$scene.gltf
+  [ -f "$file" ] || file=$build/scenes/$scene.glb
+  [ -f "$file" ] || { echo "make_references: no scene $scene (build the target interior_scene)" >&2; exit 2; }
   for seed in 1 2 3 4 5 6 7 8; do
-    "$tool" "$repo/scenes/$scene.gltf" "$out/${scene}_seed$seed.exr" \
+    "$tool" "$file" "$out/${scene}_seed$seed.exr" \
       --width 32 --height 24 --spp 16384 --seed "$seed" --max-bounces 7 --threads 2
   done
 done
