@@ -396,11 +396,18 @@ def hall_meshes():
     return [floor, plaster, stone, wood, cloth]
 
 
+def hall_materials(matte):
+    """The materials of hall_meshes(), in its order; matte: the floor and furniture Lambertian, not glossy."""
+    def glossy(roughness):
+        return {"lambert": True} if matte else {"roughness": roughness}
+    return [material("stone", (0.62, 0.58, 0.52), lambert=True), material("floor", (0.55, 0.5, 0.45), **glossy(0.6)),
+            material("wood", (0.45, 0.28, 0.15), **glossy(0.5)), material("red_cloth", (0.6, 0.12, 0.1), lambert=True),
+            material("plaster", (0.85, 0.83, 0.78), lambert=True)]
+
+
 def interior():
     """The hall lit by a sun through its roof openings, with a glossy floor and furniture."""
-    mats = [material("stone", (0.62, 0.58, 0.52), lambert=True), material("floor", (0.55, 0.5, 0.45), roughness=0.6),
-            material("wood", (0.45, 0.28, 0.15), roughness=0.5), material("red_cloth", (0.6, 0.12, 0.1), lambert=True),
-            material("plaster", (0.85, 0.83, 0.78), lambert=True)]
+    mats = hall_materials(matte=False)
     sun_dir = norm((-0.2, -1.0, -0.35))
     # A directional light's node points its -Z along the direction of travel.
     f = sun_dir
@@ -417,11 +424,9 @@ def skylit_hall():
     emitting panel 1 m above the roof that shines down (one-sided, black base colour), into the hall only
     through the skylights. Most of the hall sees light that has bounced off the floor below them: the
     large-scene row of the comparison with Cycles (bench/vs_cycles.sh)."""
-    mats = [material("stone", (0.62, 0.58, 0.52), lambert=True), material("floor", (0.55, 0.5, 0.45), lambert=True),
-            material("wood", (0.45, 0.28, 0.15), lambert=True), material("red_cloth", (0.6, 0.12, 0.1), lambert=True),
-            material("plaster", (0.85, 0.83, 0.78), lambert=True),
-            material("sky_panel", (0.0, 0.0, 0.0), emissive=(1.0, 0.97, 0.92), strength=SKY_PANEL_STRENGTH, lambert=True,
-                     double_sided=False)]
+    panel_material = material("sky_panel", (0.0, 0.0, 0.0), emissive=(1.0, 0.97, 0.92), strength=SKY_PANEL_STRENGTH,
+                              lambert=True, double_sided=False)
+    mats = hall_materials(matte=True) + [panel_material]
     X, _, H = HALL_SIZE
     panel = Mesh("sky_panel", 5)
     y = H + 1.0

@@ -114,8 +114,8 @@ test::BatchEstimate cyclesReference(const std::string& scene) {
   return test::estimateFromBatches(images);
 }
 
-test::BatchEstimate renderVplview(const Case& c) {
-  const SceneData data = loadGltf(test::builtInScene(c.scene));
+test::BatchEstimate renderVplview(const Case& c, const std::string& path) {
+  const SceneData data = loadGltf(path);
   std::vector<Image> images;
   uint64_t discarded = 0, guideSamples = 0;
   for (int b = 0; b < kBatches; ++b) {
@@ -141,11 +141,11 @@ class CyclesAnchor : public ::testing::TestWithParam<Case> {};
 
 TEST_P(CyclesAnchor, AgreesWithCyclesPixelByPixel) {
   const Case c = GetParam();
-  if (!std::filesystem::exists(test::builtInScene(c.scene)))
-    GTEST_SKIP() << test::builtInScene(c.scene) << " is not built (target interior_scene)";
+  const std::string path = test::builtInScene(c.scene);
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " is not built (target interior_scene)";
   const test::BatchEstimate cycles = cyclesReference(sceneStem(c));
   if (cycles.batches == 0) return;
-  const test::Agreement a = test::compareEstimates(renderVplview(c), cycles);
+  const test::Agreement a = test::compareEstimates(renderVplview(c, path), cycles);
   EXPECT_GT(a.samples, kWidth * kHeight * 3 / 2) << caseName(c) << ": too few noisy pixels to judge";
   test::AgreementBounds bounds = kBounds;
   bounds.imageFloor = grazingLampResidual(sceneStem(c));

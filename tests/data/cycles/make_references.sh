@@ -17,10 +17,9 @@ build=${1:-$repo/build}
 shift || true
 tool=$repo/../shared/tools/cycles/cycles-render
 out=$repo/tests/data/cycles
+. "$repo/bench/lib.sh"
 for scene in ${*:-cornell_box two_rooms skylit_hall}; do
-  file=$repo/scenes/$scene.gltf
-  [ -f "$file" ] || file=$build/scenes/$scene.glb
-  [ -f "$file" ] || { echo "make_references: no scene $scene (build the target interior_scene)" >&2; exit 2; }
+  file=$(scene_file "$repo" "$build" "$scene" make_references)
   for seed in 1 2 3 4 5 6 7 8; do
     "$tool" "$file" "$out/${scene}_seed$seed.exr" \
       --width 32 --height 24 --spp 16384 --seed "$seed" --max-bounces 7 --threads 2
