@@ -100,6 +100,12 @@ void RenderOptions::addCommonTo(CLI::App& command) {
                      "VPL connections: a join worth less than this share of what its sample holds already traces "
                      "its shadow ray with probability worth / (share x held) and weighs 1/that (0: every join traces)")
       ->check(CLI::Range(0.0f, 100.0f));
+  command.add_option_function<std::string>(
+            "--light-learning", [this](const std::string& v) { tracer.learnLights = v == "on"; },
+            "next-event estimation: on (each region of the scene picks the parts of the emitters in proportion to "
+            "what its light samples brought back in earlier passes, 30 % by power; triangle lights only) | off "
+            "(by power, then by solid angle or area)")
+      ->check(CLI::IsMember({"on", "off"}));
   command.add_option("--sky", sky, "uniform sky radiance R,G,B; 0 turns it off (default: on only without lights)");
   command.add_option("--sampler", sampler,
                      "the camera paths' numbers: sobol (stratified: Owen-scrambled Sobol', one slot per decision) | "

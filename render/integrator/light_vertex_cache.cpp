@@ -4,6 +4,7 @@
 #include <cmath>
 #include <tbb/parallel_for.h>
 #include "render/core/color.h"
+#include "render/guide/emitter_guide.h"
 #include "render/sampling/rng.h"
 #include "render/vpl/light_walk.h"
 
@@ -32,8 +33,8 @@ struct PathVertices {
 };
 
 template <class Numbers>
-void traceLightSubpath(const RenderScene& scene, const LightVertexCache& cache, Numbers& numbers, int maxLength,
-                       PathVertices& out) {
+void traceLightSubpath(const RenderScene& scene, const LightVertexCache& cache, const EmitterGuide* emitterGuide,
+                       Numbers& numbers, int maxLength, PathVertices& out) {
   const auto e = startLightPath(scene, numbers);
   if (!e) return;
   // A light that no ray can hit (a point, a direction) has no strategy that reaches its start by
@@ -45,7 +46,9 @@ void traceLightSubpath(const RenderScene& scene, const LightVertexCache& cache, 
     const float cosIn = std::abs(glm::dot(v.surface.geometricNormal, v.wIn));
     if (v.length == 1) {
       // Next-event estimation from here would have picked the start with a density of its own.
-      dVCM = connectionMis(scene.emitters().nextEventPdfTimesCos(v.surface.position, *e) / (e->pdf * cosIn));
+      const float direct = emitterGuide ? emitterGuide->nextEventPdfTimesCos(v.surface.position, *e)
+                                        : scene.emitters().nextEventPdfTimesCos(v.surface.position, *e);
+      dVCM = connectionMis(direct / (e->pdf * cosIn));
     } else {
       dVCM *= connectionMis(v.distance * v.distance) / connectionMis(cosIn);
     }
@@ -91,7 +94,8 @@ void LightVertexCache::learnFromLastPass() {
 }
 
 void LightVertexCache::build(const RenderScene& scene, uint64_t seed, uint64_t pass, int paths, int maxLength,
-                             bool stratified) {
+                             bool stratified, const EmitterGuide* emitterGuide) {
+  if (emitterGuide && !emitterGuide->active()) emitterGuide = nullptr;
   low_ = scene.data().boundsMin;
   perUnit_ = float(kCellsPerAxis) / glm::max(scene.data().boundsMax - low_, glm::vec3(1e-20f));
   learnFromLastPass();
@@ -118,11 +122,11 @@ void LightVertexCache::build(const RenderScene& scene, uint64_t seed, uint64_t p
     for (int i = b * kBatch; i < end; ++i) {
       if (stratified) {
         StratifiedWalkNumbers numbers{PixelSampler(passKey, kLightPathStream, uint64_t(i))};
-        traceLightSubpath(scene, *this, numbers, maxLength, results[size_t(b)]);
+        traceLightSubpath(scene, *this, emitterGuide, numbers, maxLength, results[size_t(b)]);
       } else {
         Rng rng = Rng::hashed(mix64(passKey ^ uint64_t(i)));
         RandomWalkNumbers numbers{rng};
-        traceLightSubpath(scene, *this, numbers, maxLength, results[size_t(b)]);
+        traceLightSubpath(scene, *this, emitterGuide, numbers, maxLength, results[size_t(b)]);
       }
     }
   });

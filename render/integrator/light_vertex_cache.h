@@ -37,6 +37,8 @@
 
 namespace vpl {
 
+class EmitterGuide;
+
 // The heuristic applied to every density ratio of the weights (power 2, as the tracer's own MIS).
 inline float connectionMis(float ratio) { return ratio * ratio; }
 
@@ -109,7 +111,9 @@ class LightVertexCache {
   // emitter folded into the position's x, and its first scatterings; render/vpl/light_walk.h) or
   // numbers hashed from (seed, pass, path). Subpaths end after maxLength segments or by Russian
   // roulette. Empty for lights that connections do not support.
-  void build(const RenderScene& scene, uint64_t seed, uint64_t pass, int paths, int maxLength, bool stratified);
+  // `emitterGuide`: the tracer's learned next-event estimation, if any (its density enters the weights).
+  void build(const RenderScene& scene, uint64_t seed, uint64_t pass, int paths, int maxLength, bool stratified,
+             const EmitterGuide* emitterGuide = nullptr);
 
   bool empty() const { return vertices_.empty(); }
   int joinsPerVertex() const { return joinsPerVertex_; }

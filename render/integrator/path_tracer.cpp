@@ -5,6 +5,7 @@
 #include <cmath>
 #include <vector>
 #include "render/core/color.h"
+#include "render/guide/emitter_guide.h"
 #include "render/integrator/light_vertex_cache.h"
 #include "render/sampling/warps.h"
 #include "render/vpl/irradiance_grid.h"
@@ -68,8 +69,9 @@ float BsdfContinuation::pdf(const SurfaceHit&, const Bsdf& bsdf, const glm::vec3
 }
 
 PathTracer::PathTracer(const RenderScene& scene, const PathTracerSettings& settings, const IrradianceGrid* irradiance,
-                       const LightVertexCache* connections)
+                       const LightVertexCache* connections, const EmitterGuide* emitterGuide)
     : scene_(scene), settings_(settings) {
+  if (emitterGuide && emitterGuide->active()) emitterGuide_ = emitterGuide;
   if (connections && scene.emitters().supportsConnections()) connections_ = connections;
   const bool windowRule = settings_.roulette == RouletteRule::Vpl || settings_.roulette == RouletteRule::Auto;
   if (windowRule && irradiance && !irradiance->empty()) irradiance_ = irradiance;
@@ -92,13 +94,17 @@ struct PathTracer::Branch {
   float dVC = 0.0f, dVCM = 0.0f;  // connections' MIS partial sums; 0 at the camera: no light tracing to it
 };
 
+float PathTracer::nextEventPdf(const glm::vec3& p, const SurfaceHit& hit) const {
+  return emitterGuide_ ? emitterGuide_->pdf(p, hit) : scene_.emitters().pdfTriangle(p, hit);
+}
+
 float PathTracer::emitterHitWeight(const SurfaceHit& surface, const glm::vec3& wo, const Branch& path) const {
   if (path.depth == 0) return 1.0f;
   const EmitterSet& emitters = scene_.emitters();
-  if (!connections_) return powerHeuristic(path.previousPdf, emitters.pdfTriangle(path.previousPosition, surface));
+  if (!connections_) return powerHeuristic(path.previousPdf, nextEventPdf(path.previousPosition, surface));
   const glm::vec3 d = surface.position - path.previousPosition;
   const float cosHit = std::abs(glm::dot(surface.geometricNormal, wo));
-  const float directPdfArea = emitters.pdfTriangle(path.previousPosition, surface) * cosHit / glm::dot(d, d);
+  const float directPdfArea = nextEventPdf(path.previousPosition, surface) * cosHit / glm::dot(d, d);
   return bidirectionalWeight(connectionMis(directPdfArea) * path.dVCM + connectionMis(emitters.pdfEmission(surface, wo)) * path.dVC);
 }
 
@@ -238,11 +244,17 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
       }
 
       // Next-event estimation: one light sample, MIS with the continuation strategy.
-      if (const auto ls = emitters.sampleStratified(surface.position, u.lightPoint(), [&] { return u.lightChoice(); })) {
-        const glm::vec3 f = glm::dot(ls->wi, surface.geometricNormal) > 0.0f ? bsdf.eval(wo, ls->wi) : glm::vec3(0.0f);
+      const auto lightChoice = [&] { return u.lightChoice(); };
+      const auto ls = emitterGuide_ ? emitterGuide_->sample(surface.position, u.lightPoint(), lightChoice)
+                                    : emitters.sampleStratified(surface.position, u.lightPoint(), lightChoice);
+      if (ls) {
+        const float cosReceiver = glm::dot(ls->wi, surface.geometricNormal);
+        const glm::vec3 f = cosReceiver > 0.0f ? bsdf.eval(wo, ls->wi) : glm::vec3(0.0f);
         if (!isBlack(f)) {
           ++stats.rays;
+          if (emitterGuide_) emitterGuide_->attempted(ls->guideSlot);
           if (!scene_.accel().occluded(spawnShadowRay(surface, ls->wi, ls->distance))) {
+            if (emitterGuide_) emitterGuide_->arrived(ls->guideSlot, luminance(ls->radiance) * cosReceiver / ls->pdf);
             const float w = nextEventWeight(*ls, surface, bsdf, wo, path, continuation);
             L += beta * f * ls->radiance * (w / ls->pdf);
           }

@@ -31,6 +31,9 @@ struct PathTracerSettings {
   int rrStartDepth = 5;
   RouletteRule roulette = RouletteRule::Auto;
   WeightWindowSettings window;
+  // Next-event estimation learns which part of which emitter each region sees (EmitterGuide); the
+  // tracer's owner makes the guide, since it learns between passes.
+  bool learnLights = false;
 
   // Empty when valid, else a readable reason.
   std::string validate() const;
@@ -82,6 +85,7 @@ class BsdfContinuation final : public ContinuationSampler {
   float pdf(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, const glm::vec3& wi) override;
 };
 
+class EmitterGuide;
 class IrradianceGrid;
 class LightVertexCache;
 struct LightVertex;
@@ -93,8 +97,10 @@ class PathTracer {
   // `connections`: light vertices to join every camera vertex to, weighted by bidirectional MIS
   // (light_vertex_cache.h); its owner rebuilds it between passes. Null, or a scene whose lights
   // connections do not support (EmitterSet::supportsConnections): none.
+  // `emitterGuide`: learned next-event estimation (render/guide/emitter_guide.h), if active; its owner
+  // updates it between passes, and builds `connections` with the same one.
   PathTracer(const RenderScene& scene, const PathTracerSettings& settings, const IrradianceGrid* irradiance = nullptr,
-             const LightVertexCache* connections = nullptr);
+             const LightVertexCache* connections = nullptr, const EmitterGuide* emitterGuide = nullptr);
 
   // Radiance arriving along the camera ray, every decision drawn from its dimension of `sampler`.
   // May be non-finite only through a bug; callers check.
@@ -115,6 +121,8 @@ class PathTracer {
   float predictedRadiance(const SurfaceHit& surface, const Bsdf& bsdf) const;
   // MIS weights of an emitter hit and of a next-event sample: against each other alone, or with
   // connections against every join that makes the same path.
+  // Next-event estimation's solid-angle density at p of an emitter hit's point.
+  float nextEventPdf(const glm::vec3& p, const SurfaceHit& hit) const;
   float emitterHitWeight(const SurfaceHit& surface, const glm::vec3& wo, const Branch& path) const;
   float nextEventWeight(const LightSample& ls, const SurfaceHit& surface, const Bsdf& bsdf, const glm::vec3& wo,
                         const Branch& path, ContinuationSampler& continuation) const;
@@ -127,6 +135,7 @@ class PathTracer {
   PathTracerSettings settings_;
   const IrradianceGrid* irradiance_ = nullptr;  // set only when the window is in use
   const LightVertexCache* connections_ = nullptr;  // set only when the scene's lights support them
+  const EmitterGuide* emitterGuide_ = nullptr;     // set only when active
 };
 
 // Power heuristic with exponent 2 (Veach 1997, §9.2.4).

@@ -213,6 +213,7 @@ std::optional<LightSample> EmitterSet::sampleChosen(const glm::vec3& p, size_t i
       s.pdf = float(double(pmf) / st->solidAngle());
       s.cosLight = std::abs(glm::dot(light.normal, s.wi));
       s.emissionPdf = emissionPdf(light, pmf, s.cosLight);
+      s.triangle = int32_t(index);
       return s;
     }
     // Sample an emissive triangle by area, convert the density to solid angle at p.
@@ -231,6 +232,7 @@ std::optional<LightSample> EmitterSet::sampleChosen(const glm::vec3& p, size_t i
     s.pdf = pmf * dist2 / (std::abs(cosLight) * light.area);
     s.cosLight = std::abs(cosLight);
     s.emissionPdf = emissionPdf(light, pmf, s.cosLight);
+    s.triangle = int32_t(index);
     return s;
   }
   if (int(index) == skyIndex_) {
@@ -277,6 +279,59 @@ float EmitterSet::pdfTrianglePoint(const glm::vec3& p, size_t index, const glm::
   const float cosLight = std::abs(glm::dot(normal, d)) / std::sqrt(dist2);
   if (!(cosLight > 1e-7f)) return 0.0f;
   return distribution_.pmf(index) * dist2 / (cosLight * light.area);
+}
+
+int32_t EmitterSet::emitterOf(const SurfaceHit& hit) const {
+  if (hit.mesh >= triangleIndex_.size() || triangleIndex_[hit.mesh].empty()) return -1;
+  return triangleIndex_[hit.mesh][hit.triangle];
+}
+
+glm::vec2 EmitterSet::squareOf(size_t index, const glm::vec3& x) const {
+  // Barycentrics of x (in the plane), then sampleUniformTriangle's two affine halves undone.
+  const TriangleLight& light = triangles_[index];
+  const glm::vec3 e1 = light.p1 - light.p0, e2 = light.p2 - light.p0, d = x - light.p0;
+  const float d11 = glm::dot(e1, e1), d12 = glm::dot(e1, e2), d22 = glm::dot(e2, e2);
+  const float d1 = glm::dot(d, e1), d2 = glm::dot(d, e2);
+  const float det = d11 * d22 - d12 * d12;
+  const float bx = (d22 * d1 - d12 * d2) / det, by = (d11 * d2 - d12 * d1) / det;
+  const float b1 = bx, b0 = 1.0f - bx - by;
+  const glm::vec2 s = b0 < b1 ? glm::vec2(2.0f * b0, b0 + b1) : glm::vec2(b0 + b1, 2.0f * b1);
+  return glm::clamp(s, glm::vec2(0.0f), glm::vec2(std::nextafter(1.0f, 0.0f)));
+}
+
+std::optional<LightSample> EmitterSet::sampleTriangleByArea(const glm::vec3& p, size_t index, glm::vec2 square,
+                                                            float areaPdf) const {
+  const TriangleLight& light = triangles_[index];
+  const float h = planeDistance(p, light);
+  if (std::isnan(h) || (h < 0.0f && !light.twoSided)) return std::nullopt;
+  const glm::vec2 b = sampleUniformTriangle(square);
+  const glm::vec3 d = trianglePoint(light, b).position - p;
+  const float dist2 = glm::dot(d, d);
+  if (!(dist2 > 0.0f)) return std::nullopt;
+  LightSample s;
+  s.distance = std::sqrt(dist2);
+  s.wi = d / s.distance;
+  const float cosLight = -glm::dot(light.normal, s.wi);
+  if (!(std::abs(cosLight) > 1e-7f)) return std::nullopt;
+  s.radiance = triangleRadiance(light, b, cosLight > 0.0f);
+  if (isBlack(s.radiance)) return std::nullopt;
+  s.pdf = areaPdf * dist2 / std::abs(cosLight);
+  s.cosLight = std::abs(cosLight);
+  s.emissionPdf = emissionPdf(light, distribution_.pmf(index), s.cosLight);
+  s.triangle = int32_t(index);
+  return s;
+}
+
+float EmitterSet::solidAnglePdfOfArea(const glm::vec3& p, size_t index, const glm::vec3& x, const glm::vec3& normal,
+                                      bool front, float areaPdf) const {
+  const TriangleLight& light = triangles_[index];
+  if (!front && !light.twoSided) return 0.0f;
+  if (std::isnan(planeDistance(p, light))) return 0.0f;
+  const glm::vec3 d = x - p;
+  const float dist2 = glm::dot(d, d);
+  const float cosLight = std::abs(glm::dot(normal, d)) / std::sqrt(dist2);
+  if (!(cosLight > 1e-7f)) return 0.0f;
+  return areaPdf * dist2 / cosLight;
 }
 
 float EmitterSet::emissionPdf(const TriangleLight& light, float pmf, float cosLight) {
@@ -368,6 +423,7 @@ std::optional<EmissionSample> EmitterSet::sampleEmissionChosen(size_t index, flo
     e.weight = triangleRadiance(light, b, front) * (kPi * light.area * sides / pmf);
     e.pdf = emissionPdf(light, pmf, std::max(0.0f, glm::dot(n, e.direction)));
     e.emitter = uint32_t(index);
+    e.square = uPos;
     return e;
   }
   const glm::vec3 travelSky = -sampleUniformSphere(uDir);

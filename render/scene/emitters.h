@@ -28,6 +28,9 @@ struct LightSample {
   // (area x solid angle, light choice included), and the cosine at the light (1 for punctual lights).
   float emissionPdf = 0.0f;
   float cosLight = 1.0f;
+  int32_t triangle = -1;  // the emitting triangle's index in the set (-1: another kind of light)
+  // EmitterGuide: the part of the emitters the sample came from (its region and cell), for learning.
+  uint32_t guideSlot = UINT32_MAX;
 };
 
 // Where a light path starts (instant radiosity): a point and direction drawn from the emission.
@@ -39,6 +42,7 @@ struct EmissionSample {
   float pdf = 0.0f;           // pdf_pos pdf_dir, light choice included (area x solid angle; sky and
                               // directional: disk area x direction)
   uint32_t emitter = 0;       // which light of the set (for nextEventPdf)
+  glm::vec2 square{0.0f};     // triangles: the point of the unit square that sampleUniformTriangle mapped
   bool deltaPosition = false; // punctual: no ray can hit where the path starts
 };
 
@@ -97,6 +101,26 @@ class EmitterSet {
   // Whether every light here is one that bidirectional connections weight exactly: triangles and
   // point, spot and directional lights without a range window; not the sky.
   bool supportsConnections() const;
+
+  // What EmitterGuide (render/guide/emitter_guide.h), which learns which part of which emitter
+  // each region of the scene sees, builds on: it cuts each triangle's unit square (the domain of
+  // sampleUniformTriangle, whose map preserves area) into cells and samples a cell's points by area.
+  bool onlyTriangles() const { return !triangles_.empty() && punctual_.empty() && skyIndex_ < 0; }
+  // The power-proportional probability of choosing emitting triangle `index`.
+  float trianglePmf(size_t index) const { return distribution_.pmf(index); }
+  float triangleArea(size_t index) const { return triangles_[index].area; }
+  glm::vec3 triangleNormal(size_t index) const { return triangles_[index].normal; }
+  // The emitter index of a hit's triangle, or -1 where it does not emit.
+  int32_t emitterOf(const SurfaceHit& hit) const;
+  // The unit square's point that sampleUniformTriangle maps to x, a point of triangle `index`.
+  glm::vec2 squareOf(size_t index, const glm::vec3& x) const;
+  // Next-event estimation from p towards the point of triangle `index` at `square`, a point drawn
+  // with density areaPdf (per unit area of the triangle, every choice included).
+  std::optional<LightSample> sampleTriangleByArea(const glm::vec3& p, size_t index, glm::vec2 square, float areaPdf) const;
+  // The solid-angle density at p of area density areaPdf at point x of triangle `index` (facing
+  // `normal`, hit on side `front`): 0 where sampleTriangleByArea would send nothing.
+  float solidAnglePdfOfArea(const glm::vec3& p, size_t index, const glm::vec3& x, const glm::vec3& normal, bool front,
+                            float areaPdf) const;
 
   // Emitted radiance of a surface hit towards wo (0 unless the material emits on that side).
   glm::vec3 emitted(const SurfaceHit& hit, const glm::vec3& wo) const;

@@ -8,6 +8,7 @@
 #include "render/core/error.h"
 #include "render/core/stopwatch.h"
 #include "render/film/film.h"
+#include "render/guide/emitter_guide.h"
 #include "render/guide/guide_builder.h"
 #include "render/integrator/guided_continuation.h"
 #include "render/scene/camera.h"
@@ -98,6 +99,7 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
   const bool connecting = connectionPaths > 0 && scene.emitters().supportsConnections();
   if (connectionPaths > 0 && !connecting && !scene.emitters().empty())
     result.notices.push_back("VPL connections are off: they do not support the sky or lights with a range");
+  EmitterGuide emitterGuide(scene, settings.tracer.learnLights && settings.mode != SamplingMode::Preview);
   LightVertexCache connectionCache(settings.connections);
   const LightVertexCache* connections = connecting ? &connectionCache : nullptr;
   if (connecting) result.connectionPaths = connectionPaths;
@@ -108,10 +110,10 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
     const auto t = Clock::now();
     irradiance = IrradianceGrid(scene, IrradianceGrid::kPhotons, settings.seed, settings.tracer.maxDepth);
     result.timings.irradiance = secondsSince(t);
-    return std::make_unique<PathTracer>(scene, settings.tracer, &irradiance, connections);
+    return std::make_unique<PathTracer>(scene, settings.tracer, &irradiance, connections, &emitterGuide);
   };
   std::unique_ptr<PathTracer> tracer =
-      vplRoulette ? windowTracer() : std::make_unique<PathTracer>(scene, settings.tracer, nullptr, connections);
+      vplRoulette ? windowTracer() : std::make_unique<PathTracer>(scene, settings.tracer, nullptr, connections, &emitterGuide);
   VplField field;
   GuideField guide;
   std::optional<FilmLearners> learners;  // what the passes so far teach the guided continuations
@@ -169,9 +171,11 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
     if (!timed && int(pass) >= settings.spp) break;
     if (timed && pass > 0 && stop.load()) break;
     const auto passStart = Clock::now();
+    emitterGuide.learnFromLastPass();
     if (connecting) {
       const auto t = Clock::now();
-      connectionCache.build(scene, settings.seed, pass, connectionPaths, settings.tracer.maxDepth - 1, settings.stratifiedSampler);
+      connectionCache.build(scene, settings.seed, pass, connectionPaths, settings.tracer.maxDepth - 1, settings.stratifiedSampler,
+                            &emitterGuide);
       result.timings.connections += secondsSince(t);
       result.rays += connectionCache.rays();
     }

@@ -1,0 +1,142 @@
+#include "render/guide/emitter_guide.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace vpl {
+
+EmitterGuide::EmitterGuide(const RenderScene& scene, bool enabled) {
+  const EmitterSet& emitters = scene.emitters();
+  if (!enabled || !emitters.onlyTriangles() || emitters.triangleCount() > size_t(kMaxTriangles)) return;
+  const size_t triangles = emitters.triangleCount();
+  // The finest square grid that keeps every triangle's cells within kMaxCells in all.
+  while (triangles * size_t(4 * grid_ * grid_) <= size_t(kMaxCells)) grid_ *= 2;
+  cells_ = int(triangles) * grid_ * grid_;
+  for (size_t t = 0; t < triangles; ++t) {
+    area_.push_back(emitters.triangleArea(t));
+    for (int c = 0; c < grid_ * grid_; ++c) base_.push_back(emitters.trianglePmf(t) / float(grid_ * grid_));
+  }
+  // Near-cubic regions, about kTargetRegions of them; a flat box gets one layer along its thin axis.
+  low_ = scene.data().boundsMin;
+  const glm::vec3 extent = glm::max(scene.data().boundsMax - low_, glm::vec3(0.0f));
+  const float largest = std::max(extent.x, std::max(extent.y, extent.z));
+  if (!(largest > 0.0f) || !std::isfinite(largest)) return;
+  const glm::vec3 safe = glm::max(extent, glm::vec3(largest * 1e-3f));
+  const float side = std::cbrt(safe.x * safe.y * safe.z / float(kTargetRegions));
+  regionsPerAxis_ = glm::clamp(glm::ivec3(glm::round(safe / side)), glm::ivec3(1), glm::ivec3(kTargetRegions));
+  perUnit_ = glm::vec3(regionsPerAxis_) / safe;
+  const size_t regionCount = size_t(regionsPerAxis_.x) * size_t(regionsPerAxis_.y) * size_t(regionsPerAxis_.z);
+  state_.assign(regionCount, State::Undecided);
+  cdf_.assign(regionCount * size_t(cells_), 0.0f);
+  sums_.assign(regionCount * size_t(cells_), 0.0);
+  attempts_.assign(regionCount, 0);
+  arrivals_.assign(regionCount, 0);
+  lanes_ = std::vector<Lane>(kLanes);
+  for (Lane& l : lanes_) {
+    l.sums = std::vector<std::atomic<uint64_t>>(regionCount * size_t(cells_));
+    l.attempts = std::vector<std::atomic<uint64_t>>(regionCount);
+    l.arrivals = std::vector<std::atomic<uint64_t>>(regionCount);
+    l.touched = std::vector<std::atomic<uint8_t>>(regionCount);
+  }
+  scene_ = &scene;
+}
+
+EmitterGuide::Lane& EmitterGuide::lane() const {
+  static std::atomic<size_t> next{0};
+  static thread_local const size_t index = next.fetch_add(1, std::memory_order_relaxed) % kLanes;
+  return lanes_[index];
+}
+
+uint32_t EmitterGuide::regionOf(const glm::vec3& p) const {
+  const glm::ivec3 c = glm::clamp(glm::ivec3(glm::clamp((p - low_) * perUnit_, 0.0f, float(kTargetRegions))),
+                                  glm::ivec3(0), regionsPerAxis_ - 1);
+  return uint32_t((c.z * regionsPerAxis_.y + c.y) * regionsPerAxis_.x + c.x);
+}
+
+uint32_t EmitterGuide::slotOf(uint32_t region, const LightSample& s, const glm::vec3& p) const {
+  const size_t t = size_t(s.triangle);
+  return region * uint32_t(cells_) + cellOf(t, scene_->emitters().squareOf(t, p + s.wi * s.distance));
+}
+
+float EmitterGuide::learnedRegionShare() const {
+  if (state_.empty()) return 0.0f;
+  return float(double(std::count(state_.begin(), state_.end(), State::Learned)) / double(state_.size()));
+}
+
+void EmitterGuide::learnFromLastPass() {
+  if (!active()) return;
+  for (size_t r = 0; r < state_.size(); ++r) {
+    if (state_[r] == State::Default) continue;
+    bool touched = false;
+    for (Lane& l : lanes_) {
+      attempts_[r] += l.attempts[r].exchange(0, std::memory_order_relaxed);
+      arrivals_[r] += l.arrivals[r].exchange(0, std::memory_order_relaxed);
+      touched |= l.touched[r].exchange(0, std::memory_order_relaxed) != 0;
+    }
+    double* sums = &sums_[r * size_t(cells_)];
+    double total = 0.0;
+    for (int c = 0; c < cells_; ++c) {
+      uint64_t sum = 0;
+      if (touched)
+        for (Lane& l : lanes_) sum += l.sums[r * size_t(cells_) + size_t(c)].exchange(0, std::memory_order_relaxed);
+      sums[c] += double(sum) / double(kFixedPoint);
+      total += sums[c];
+    }
+    // The switch, once: to learning where most light samples were wasted and something arrived.
+    bool switched = false;
+    if (state_[r] == State::Undecided && attempts_[r] >= kMinAttempts) {
+      const bool wasted = double(arrivals_[r]) < double(kArrivalShare) * double(attempts_[r]);
+      state_[r] = wasted && total > 0.0 ? State::Learned : State::Default;
+      switched = state_[r] == State::Learned;
+    }
+    if (state_[r] != State::Learned || !(touched || switched)) continue;
+    float* cdf = &cdf_[r * size_t(cells_)];
+    double cumulative = 0.0;
+    for (int c = 0; c < cells_; ++c) {
+      cumulative += double(kBaseShare) * double(base_[size_t(c)]) + (1.0 - double(kBaseShare)) * sums[c] / total;
+      cdf[c] = float(cumulative);
+    }
+    cdf[cells_ - 1] = 1.0f;
+  }
+}
+
+std::optional<LightSample> EmitterGuide::sampleLearned(const glm::vec3& p, uint32_t region, glm::vec2 u) const {
+  const float* cdf = &cdf_[size_t(region) * size_t(cells_)];
+  // The first cell whose cumulative probability passes u.x; u.x rescaled within it serves the point.
+  const uint32_t cell = uint32_t(std::min(int(std::upper_bound(cdf, cdf + cells_, u.x) - cdf), cells_ - 1));
+  const float low = cell > 0 ? cdf[cell - 1] : 0.0f, width = cdf[cell] - low;
+  if (!(width > 0.0f)) return std::nullopt;
+  const float x = std::clamp((u.x - low) / width, 0.0f, std::nextafter(1.0f, 0.0f));
+  const size_t triangle = cell / uint32_t(grid_ * grid_);
+  const uint32_t inTriangle = cell % uint32_t(grid_ * grid_);
+  const glm::vec2 square = (glm::vec2(float(inTriangle % uint32_t(grid_)), float(inTriangle / uint32_t(grid_))) +
+                            glm::vec2(x, u.y)) / float(grid_);
+  auto s = scene_->emitters().sampleTriangleByArea(p, triangle, square, width * float(grid_ * grid_) / area_[triangle]);
+  if (s) s->guideSlot = region * uint32_t(cells_) + cell;
+  return s;
+}
+
+float EmitterGuide::pdf(const glm::vec3& p, const SurfaceHit& hit) const {
+  const EmitterSet& emitters = scene_->emitters();
+  const uint32_t region = regionOf(p);
+  if (state_[region] != State::Learned) return emitters.pdfTriangle(p, hit);
+  const int32_t t = emitters.emitterOf(hit);
+  if (t < 0) return 0.0f;
+  const float area = areaPdf(region, size_t(t), emitters.squareOf(size_t(t), hit.position));
+  return emitters.solidAnglePdfOfArea(p, size_t(t), hit.position, hit.geometricNormal, hit.frontFace, area);
+}
+
+float EmitterGuide::nextEventPdfTimesCos(const glm::vec3& p, const EmissionSample& e) const {
+  const EmitterSet& emitters = scene_->emitters();
+  const uint32_t region = regionOf(p);
+  if (state_[region] != State::Learned) return emitters.nextEventPdfTimesCos(p, e);
+  const glm::vec3 d = p - e.position;
+  const float dist2 = glm::dot(d, d);
+  if (!(dist2 > 0.0f)) return 0.0f;
+  const bool front = glm::dot(e.normal, emitters.triangleNormal(e.emitter)) > 0.0f;
+  const float solidAngle = emitters.solidAnglePdfOfArea(p, e.emitter, e.position, e.normal, front,
+                                                        areaPdf(region, e.emitter, e.square));
+  return solidAngle * std::abs(glm::dot(e.normal, d)) / std::sqrt(dist2);
+}
+
+}  // namespace vpl

@@ -1,0 +1,134 @@
+// Learned next-event estimation: which part of which emitter each region of the scene sees.
+//
+// Where light enters through openings (skylights, a door ajar), most of an emitter is hidden from
+// most points, and a light sample drawn by power and solid angle ends on the roof: its shadow ray is
+// paid for nothing. Here the scene's box is cut into regions and every emitting triangle's unit
+// square (the domain of sampleUniformTriangle, whose map preserves area) into cells. Every region
+// starts with EmitterSet's own sampling (by power, then by solid angle or area) and records, per
+// cell, what its unoccluded samples brought back (each sample's irradiance estimate: over its
+// density, so the sums estimate each cell's whole share). Once kMinAttempts of its shadow rays are
+// traced, a region decides for good: if fewer than kArrivalShare of them arrived (most light samples
+// end on something else) it picks cell c with
+//     P_r(c) = s base(c) + (1 - s) learned_r(c),
+// base(c) the triangle's power share over its cell count, learned_r(c) the region's share of what
+// was recorded from c, s = kBaseShare (no cell's density falls below that share of the power
+// choice's), and a point uniform over the cell's area; otherwise it keeps EmitterSet's sampling and
+// records nothing more. So regions that see their lights (a Cornell box) keep solid-angle sampling,
+// lose nothing to a noisy table and, after the first passes, pay only a region lookup.
+//
+// The tables and switches change only between passes and every strategy that asks the density (an
+// emitter hit's MIS weight, a light path's first vertex in the joins' weights) sees the same, so the
+// estimate stays unbiased whatever was learned; the records are integer sums, so the next pass's
+// tables do not depend on the thread count.
+//
+// Only for scenes whose lights are all triangles, and at most kMaxTriangles of them (otherwise
+// inactive: the caller keeps EmitterSet's own sampling).
+#pragma once
+#include <atomic>
+#include <cstdint>
+#include <optional>
+#include <vector>
+#include <glm/glm.hpp>
+#include "render/scene/emitters.h"
+#include "render/scene/render_scene.h"
+
+namespace vpl {
+
+class EmitterGuide {
+ public:
+  static constexpr float kBaseShare = 0.3f;
+  static constexpr float kArrivalShare = 0.5f;
+  static constexpr uint64_t kMinAttempts = 256;
+  static constexpr int kMaxCells = 128;        // per region: cells over all triangles
+  static constexpr int kMaxTriangles = kMaxCells;
+  static constexpr int kTargetRegions = 1024;  // the box is cut into about this many, near-cubic
+
+  EmitterGuide() = default;
+  // Inactive unless `enabled` and the scene's lights suit it (see above).
+  EmitterGuide(const RenderScene& scene, bool enabled);
+
+  bool active() const { return scene_ != nullptr; }
+  // Between passes only: what the last pass's samples recorded joins the tables.
+  void learnFromLastPass();
+
+  // Next-event estimation from p (a point of the scene), from the numbers EmitterSet::sampleStratified
+  // takes. In a learned region u.x picks the cell and, rescaled, with u.y the point within it. The
+  // sample's guideSlot names its region and cell for attempted() and arrived().
+  template <class SpareNumber>
+  std::optional<LightSample> sample(const glm::vec3& p, glm::vec2 u, SpareNumber&& spareNumber) const {
+    const uint32_t region = regionOf(p);
+    if (state_[region] == State::Learned) return sampleLearned(p, region, u);
+    auto s = scene_->emitters().sampleStratified(p, u, spareNumber);
+    if (s && s->triangle >= 0 && state_[region] == State::Undecided) s->guideSlot = slotOf(region, *s, p);
+    return s;
+  }
+  // The solid-angle density at p with which sample() picks the emitting point of a hit.
+  float pdf(const glm::vec3& p, const SurfaceHit& hit) const;
+  // The same for a light path's start e (EmitterSet::nextEventPdfTimesCos's meaning: times the
+  // cosine at the light).
+  float nextEventPdfTimesCos(const glm::vec3& p, const EmissionSample& e) const;
+  // A sample's shadow ray is traced ...
+  void attempted(uint32_t slot) const {
+    if (slot == UINT32_MAX) return;
+    const uint32_t region = slot / uint32_t(cells_);
+    if (state_[region] == State::Undecided) lane().attempts[region].fetch_add(1, std::memory_order_relaxed);
+  }
+  // ... and arrived, bringing back `value` (luminance of its radiance times the receiver's cosine
+  // over its density). Any thread, any order.
+  void arrived(uint32_t slot, float value) const {
+    if (slot == UINT32_MAX) return;
+    Lane& l = lane();
+    const uint32_t region = slot / uint32_t(cells_);
+    if (state_[region] == State::Undecided) l.arrivals[region].fetch_add(1, std::memory_order_relaxed);
+    if (!l.touched[region].load(std::memory_order_relaxed)) l.touched[region].store(1, std::memory_order_relaxed);
+    if (value > 0.0f) l.sums[slot].fetch_add(uint64_t(std::min(value, kLargestRecord) * kFixedPoint), std::memory_order_relaxed);
+  }
+  // The share of regions that sample from what they learned.
+  float learnedRegionShare() const;
+  int regions() const { return int(state_.size()); }
+  int cells() const { return cells_; }
+
+ private:
+  static constexpr float kFixedPoint = 65536.0f;  // 2^16: records are summed as integers
+  static constexpr float kLargestRecord = 1.0e6f;
+  // This pass's records, in kLanes copies: the threads record into different lanes (by the order
+  // in which they first record), so that two cores do not pass the same cache lines back and forth.
+  static constexpr size_t kLanes = 4;
+  struct Lane {
+    std::vector<std::atomic<uint64_t>> sums;                 // per region, per cell
+    std::vector<std::atomic<uint64_t>> attempts, arrivals;  // per region
+    std::vector<std::atomic<uint8_t>> touched;               // per region: any sum this pass
+  };
+
+  uint32_t regionOf(const glm::vec3& p) const;
+  // Cell index of a point of triangle t at `square`.
+  uint32_t cellOf(size_t triangle, glm::vec2 square) const {
+    const glm::ivec2 c = glm::min(glm::ivec2(square * float(grid_)), glm::ivec2(grid_ - 1));
+    return uint32_t((int(triangle) * grid_ + c.y) * grid_ + c.x);
+  }
+  uint32_t slotOf(uint32_t region, const LightSample& s, const glm::vec3& p) const;
+  // Area density of the point at `square` of triangle t in learned region r.
+  float areaPdf(uint32_t region, size_t triangle, glm::vec2 square) const {
+    const float* cdf = &cdf_[size_t(region) * size_t(cells_)];
+    const uint32_t cell = cellOf(triangle, square);
+    return (cdf[cell] - (cell > 0 ? cdf[cell - 1] : 0.0f)) * float(grid_ * grid_) / area_[triangle];
+  }
+  std::optional<LightSample> sampleLearned(const glm::vec3& p, uint32_t region, glm::vec2 u) const;
+  Lane& lane() const;
+
+  const RenderScene* scene_ = nullptr;
+  int grid_ = 1;   // cells per side of a triangle's square
+  int cells_ = 0;  // triangles x grid^2
+  glm::ivec3 regionsPerAxis_{1};
+  glm::vec3 low_{0.0f}, perUnit_{0.0f};
+  std::vector<float> area_;       // per triangle
+  std::vector<float> base_;       // per cell: the power choice
+  enum class State : uint8_t { Undecided, Default, Learned };
+  std::vector<State> state_;      // per region: Learned samples from its table, the others as EmitterSet
+  std::vector<float> cdf_;        // per region, per cell: cumulative, the last exactly 1 (learned regions)
+  std::vector<double> sums_;      // per region, per cell: every pass so far
+  std::vector<uint64_t> attempts_, arrivals_;  // per region: every pass so far
+  mutable std::vector<Lane> lanes_;
+};
+
+}  // namespace vpl
