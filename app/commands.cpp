@@ -59,6 +59,10 @@ nlohmann::ordered_json summaryJson(const RenderJobSettings& s, const RenderJobRe
   j["bsdf_samples"] = r.bsdfSamples;
   j["guide_samples"] = r.guideSamples;
   j["triangles"] = r.triangles;
+  // Learned next-event estimation: the share of the scene's regions that sample from what they learned
+  // (null: off, or not for this scene's lights).
+  if (s.mode != SamplingMode::Preview)
+    j["light_learning_regions"] = r.learnedLightRegions >= 0.0 ? nlohmann::json(r.learnedLightRegions) : nlohmann::json(nullptr);
   if (s.mode != SamplingMode::Brdf) {
     j["vpls"] = r.vplCount;
     j[s.mode == SamplingMode::Preview ? "slices" : "cache_points"] = r.sliceCount;

@@ -102,7 +102,7 @@ void RenderOptions::addCommonTo(CLI::App& command) {
       ->check(CLI::Range(0.0f, 100.0f));
   command.add_option_function<std::string>(
             "--light-learning", [this](const std::string& v) { tracer.learnLights = v == "on"; },
-            "next-event estimation: on (each region of the scene picks the parts of the emitters in proportion to "
+            "next-event estimation: on (the default; each region of the scene picks the parts of the emitters in proportion to "
             "what its light samples brought back in earlier passes, 30 % by power; triangle lights only) | off "
             "(by power, then by solid angle or area)")
       ->check(CLI::IsMember({"on", "off"}));

@@ -33,7 +33,7 @@ struct PathTracerSettings {
   WeightWindowSettings window;
   // Next-event estimation learns which part of which emitter each region sees (EmitterGuide); the
   // tracer's owner makes the guide, since it learns between passes.
-  bool learnLights = false;
+  bool learnLights = true;
 
   // Empty when valid, else a readable reason.
   std::string validate() const;

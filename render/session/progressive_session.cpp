@@ -8,6 +8,7 @@
 #include "render/film/film.h"
 #include "render/guide/guide_builder.h"
 #include "render/integrator/guided_continuation.h"
+#include "render/guide/emitter_guide.h"
 #include "render/session/film_learners.h"
 #include "render/session/tile_renderer.h"
 #include "render/session/join_depth_trial.h"
@@ -63,6 +64,7 @@ struct ProgressiveSession::CameraState {
     WindowSwitch window;  // the auto roulette rule's decision for this film
     std::unique_ptr<FilmLearners> learners;     // what this film's passes teach the guided continuations
     std::unique_ptr<LightVertexCache> joins;    // VPL connections: its choice of vertices learns from this film's passes
+    std::unique_ptr<EmitterGuide> lights;       // learned next-event estimation, from this film's passes
     std::unique_ptr<JoinDepthTrial> joinTrial;  // --join-depth auto: which depth this film's passes join to
   };
   std::optional<Request> key;
@@ -332,7 +334,9 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
     mine.joins = std::make_unique<LightVertexCache>(settings_.connections);
     if (settings_.connections.joinDepth == ConnectionSettings::kJoinDepthAuto) mine.joinTrial = std::make_unique<JoinDepthTrial>(w, h);
   }
-  std::optional<PathTracer> joinTracer, joinWindowTracer;
+  if (settings_.tracer.learnLights && !mine.lights) mine.lights = std::make_unique<EmitterGuide>(scene, true);
+  const EmitterGuide* lights = mine.lights && mine.lights->active() ? mine.lights.get() : nullptr;
+  std::optional<PathTracer> filmTracer, filmWindowTracer;  // with this film's joins or learned lights
   auto refineTracer = [&]() -> const PathTracer& {
     const bool windowed = rule == RouletteRule::Vpl || (rule == RouletteRule::Auto && mine.window.on());
     if (windowed && !windowTracer_) {  // once per scene, when a film first asks for it
@@ -341,9 +345,11 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
       window.roulette = RouletteRule::Vpl;
       windowTracer_ = std::make_unique<PathTracer>(scene, window, irradiance_.get());
     }
-    if (joinPaths <= 0) return windowed ? *windowTracer_ : tracer_;
-    std::optional<PathTracer>& t = windowed ? joinWindowTracer : joinTracer;
-    if (!t) t.emplace(scene, windowed ? windowTracer_->settings() : settings_.tracer, windowed ? irradiance_.get() : nullptr, mine.joins.get());
+    if (joinPaths <= 0 && !lights) return windowed ? *windowTracer_ : tracer_;
+    std::optional<PathTracer>& t = windowed ? filmWindowTracer : filmTracer;
+    if (!t)
+      t.emplace(scene, windowed ? windowTracer_->settings() : settings_.tracer, windowed ? irradiance_.get() : nullptr,
+                joinPaths > 0 ? mine.joins.get() : nullptr, lights);
     return *t;
   };
   std::optional<TileRenderer> renderer;
@@ -365,8 +371,9 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
     // window's last decision even when a mode switch cancelled a pass; a cancelled trial pass is run again.
     const uint64_t slot = uint64_t(mine.complete);
     const auto t = Clock::now();
+    if (mine.lights) mine.lights->learnFromLastPass();
     if (joinPaths > 0) mine.joins->build(scene, settings_.seed, mine.nextPass, joinPaths, settings_.tracer.maxDepth - 1,
-                                      settings_.stratifiedSampler);
+                                      settings_.stratifiedSampler, lights);
     const uint64_t index = mine.nextPass++;
     Film& target = mine.joinTrial ? mine.joinTrial->beginPass(slot, *mine.film, *mine.joins) : *mine.film;
     const PassStats pass = renderer->renderPass(target, index, &cancel_);

@@ -210,6 +210,7 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
     if (progress) progress(timed ? std::min(1.0, secondsSince(loaded) / settings.timeBudget) : double(pass + 1) / settings.spp);
   }
   watch.reset();
+  if (emitterGuide.active()) result.learnedLightRegions = emitterGuide.learnedRegionShare();
   if (learners) {
     result.learnedBsdfProbability = learners->meanBsdfProbability();
     result.learnedGuideShare = learners->meanGuideShare();

@@ -62,6 +62,7 @@ struct RenderJobResult {
   std::vector<double> joinDepthScores;   // its score per candidate (JoinDepthTrial::kCandidates)
   int connectionPaths = 0;               // VPL connections: light paths per pass (0: none)
   double learnedBsdfProbability = -1.0;  // mis: the mean learned BSDF probability over cache points (-1: none)
+  double learnedLightRegions = -1.0;     // learned next-event estimation: the share of regions that learned (-1: off)
   double learnedGuideShare = -1.0;       // learned guides: the mean weight of what was learned against the VPLs
   size_t guideBytes = 0;
   std::vector<std::string> notices;

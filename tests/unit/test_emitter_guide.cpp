@@ -1,0 +1,238 @@
+// Learned next-event estimation (render/guide/emitter_guide.h) on a room lit through a skylight: an
+// emitting quad above a roof with one square opening. What it must keep: the density a sample reports
+// is the one pdf() gives an emitter hit and the one its histogram shows, before and after a region
+// learns; a learned region's samples arrive more often; and the path tracer converges to the same
+// image with learning on and off, in brdf and in mis (whose joins weigh the learned density too).
+#include <cmath>
+#include <cstdio>
+#include <optional>
+#include <random>
+#include "render/guide/emitter_guide.h"
+#include "render/scene/render_scene.h"
+#include "tests/unit/pixel_agreement.h"
+#include "tests/unit/support.h"
+
+namespace vpl {
+namespace {
+
+constexpr float kRoof = 1.0f, kLight = 1.5f, kHalf = 2.0f, kHole = 0.3f;
+
+// Floor at z = 0 and a roof at z = kRoof over [-kHalf, kHalf]^2, the roof open over [-kHole, kHole]^2;
+// an emitting quad of [-kHalf, kHalf]^2 at z = kLight facing down. Everything else is grey Lambertian.
+SceneData skylightScene() {
+  SceneData s;
+  Material grey;
+  grey.baseColor = glm::vec3(0.5f);
+  grey.metallic = 0.0f;
+  grey.roughness = 1.0f;
+  grey.specularFactor = 0.0f;
+  grey.doubleSided = true;
+  s.materials.push_back(grey);
+  Material light;
+  light.baseColor = glm::vec3(0.0f);
+  light.emission = glm::vec3(4.0f, 3.0f, 2.0f);
+  s.materials.push_back(light);
+  const auto quad = [&](glm::vec2 lo, glm::vec2 hi, float z, uint32_t material, bool down) {
+    MeshData m;
+    m.positions = {{lo.x, lo.y, z}, {hi.x, lo.y, z}, {hi.x, hi.y, z}, {lo.x, hi.y, z}};
+    m.indices = down ? std::vector<uint32_t>{0, 2, 1, 0, 3, 2} : std::vector<uint32_t>{0, 1, 2, 0, 2, 3};
+    m.material = material;
+    s.meshes.push_back(m);
+  };
+  quad({-kHalf, -kHalf}, {kHalf, kHalf}, kLight, 1, true);  // mesh 0: the light, facing down
+  quad({-kHalf, -kHalf}, {kHalf, kHalf}, 0.0f, 0, false);   // the floor
+  // The roof around the opening, in four strips.
+  quad({-kHalf, -kHalf}, {kHalf, -kHole}, kRoof, 0, true);
+  quad({-kHalf, kHole}, {kHalf, kHalf}, kRoof, 0, true);
+  quad({-kHalf, -kHole}, {-kHole, kHole}, kRoof, 0, true);
+  quad({kHole, -kHole}, {kHalf, kHole}, kRoof, 0, true);
+  s.boundsMin = glm::vec3(-kHalf, -kHalf, 0.0f);
+  s.boundsMax = glm::vec3(kHalf, kHalf, kLight);
+  CameraData camera;
+  camera.eye = glm::vec3(0.0f, -1.9f, 0.9f);
+  camera.target = glm::vec3(0.0f, 0.0f, 0.0f);
+  camera.yfov = 1.2f;
+  s.camera = camera;
+  return s;
+}
+
+struct Uniforms {
+  std::mt19937_64 engine;
+  explicit Uniforms(uint64_t seed) : engine(seed) {}
+  float next() { return float(engine() >> 40) * 0x1p-24f; }
+  glm::vec2 next2() {
+    const float a = next();
+    return {a, next()};
+  }
+};
+
+// The light's point along p + t w (mesh 0, either triangle), as the surface hit a BSDF ray would make.
+std::optional<SurfaceHit> lightHit(const RenderScene& scene, const glm::vec3& p, const glm::vec3& w) {
+  if (!(w.z > 0.0f)) return std::nullopt;
+  const float t = (kLight - p.z) / w.z;
+  const glm::vec3 x = p + t * w;
+  if (std::abs(x.x) > kHalf || std::abs(x.y) > kHalf) return std::nullopt;
+  // The quad's diagonal runs from (-h, -h) to (h, h): triangle 0 (vertices 0, 2, 1) lies below it.
+  SurfaceHit hit;
+  hit.position = x;
+  hit.geometricNormal = glm::vec3(0.0f, 0.0f, -1.0f);
+  hit.mesh = 0;
+  hit.triangle = x.y <= x.x ? 0u : 1u;
+  hit.frontFace = true;
+  hit.coordinateScale = kHalf;
+  (void)scene;
+  return hit;
+}
+
+// Light samples from points near `centre`, their shadow rays traced, for `passes` passes.
+void learn(const RenderScene& scene, const EmitterGuide& guide, const glm::vec3& centre, int passes, uint64_t seed,
+           EmitterGuide& mutableGuide) {
+  Uniforms u(seed);
+  for (int pass = 0; pass < passes; ++pass) {
+    for (int i = 0; i < 2000; ++i) {
+      const glm::vec3 p = centre + glm::vec3(0.2f * (u.next() - 0.5f), 0.2f * (u.next() - 0.5f), 0.0f);
+      const float spare = u.next();
+      const auto ls = guide.sample(p, u.next2(), [&] { return spare; });
+      if (!ls) continue;
+      guide.attempted(ls->guideSlot);
+      Ray shadow{p, ls->wi, ls->distance * (1.0f - 1e-4f)};
+      if (!scene.accel().occluded(shadow)) guide.arrived(ls->guideSlot, 1.0f / ls->pdf);
+    }
+    mutableGuide.learnFromLastPass();
+  }
+}
+
+double arrivalRate(const RenderScene& scene, const EmitterGuide& guide, const glm::vec3& p, uint64_t seed) {
+  Uniforms u(seed);
+  int arrived = 0, drawn = 0;
+  for (int i = 0; i < 4000; ++i) {
+    const float spare = u.next();
+    const auto ls = guide.sample(p, u.next2(), [&] { return spare; });
+    if (!ls) continue;
+    ++drawn;
+    if (!scene.accel().occluded(Ray{p, ls->wi, ls->distance * (1.0f - 1e-4f)})) ++arrived;
+  }
+  return drawn > 0 ? double(arrived) / double(drawn) : 0.0;
+}
+
+// Per sample the reported density equals pdf() at the hit, and the histogram of directions follows it.
+void expectDensityIsPdf(const RenderScene& scene, const EmitterGuide& guide, const glm::vec3& p, uint64_t seed,
+                        const std::string& what) {
+  Uniforms u(seed);
+  int compared = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const float spare = u.next();
+    const auto ls = guide.sample(p, u.next2(), [&] { return spare; });
+    if (!ls) continue;
+    const auto hit = lightHit(scene, p, ls->wi);
+    ASSERT_TRUE(hit.has_value()) << what;
+    ASSERT_NEAR(guide.pdf(p, *hit) / ls->pdf, 1.0, 2e-3) << what << ", sample " << i;
+    ++compared;
+  }
+  EXPECT_GT(compared, 19000) << what;
+  Uniforms h(seed + 1);
+  const auto chi = test::chiSquareSphere(
+      [&] {
+        const float spare = h.next();
+        const auto ls = guide.sample(p, h.next2(), [&] { return spare; });
+        return ls ? ls->wi : glm::vec3(0.0f);
+      },
+      [&](const glm::vec3& w) {
+        const auto hit = lightHit(scene, p, w);
+        return hit ? double(guide.pdf(p, *hit)) : 0.0;
+      },
+      300000, 64, 128, 16);
+  EXPECT_GT(chi.pValue, 1e-3) << what << ": " << chi.report;
+}
+
+TEST(EmitterGuide, LearnsWhatAnOpeningShowsAndKeepsItsDensityExact) {
+  const RenderScene scene(skylightScene());
+  EmitterGuide guide(scene, true);
+  ASSERT_TRUE(guide.active());
+  const glm::vec3 underHole(0.05f, 0.05f, 0.01f);
+  expectDensityIsPdf(scene, guide, underHole, 3, "before learning");
+  const double before = arrivalRate(scene, guide, underHole, 5);
+  learn(scene, guide, underHole, 4, 7, guide);
+  EXPECT_GT(guide.learnedRegionShare(), 0.0f);
+  const double after = arrivalRate(scene, guide, underHole, 5);
+  // The opening shows about (2 x 0.6)^2 / 4^2 = 9 % of the light from under it; with 70 % of the
+  // choice learned, most samples should arrive.
+  EXPECT_LT(before, 0.2);
+  EXPECT_GT(after, 0.5) << "before learning " << before;
+  std::printf("arrivals from under the opening: %.3f before learning, %.3f after\n", before, after);
+  expectDensityIsPdf(scene, guide, underHole, 11, "after learning");
+  // A light path's start, as the joins' weights ask for it: the same density times the light's cosine.
+  Uniforms u(13);
+  for (int i = 0; i < 1000; ++i) {
+    const auto e = scene.emitters().sampleEmission(u.next(), u.next2(), u.next2());
+    ASSERT_TRUE(e.has_value());
+    const glm::vec3 d = e->position - underHole;
+    const auto hit = lightHit(scene, underHole, glm::normalize(d));
+    ASSERT_TRUE(hit.has_value());
+    const float cosLight = std::abs(d.z) / glm::length(d);
+    EXPECT_NEAR(guide.nextEventPdfTimesCos(underHole, *e) / (guide.pdf(underHole, *hit) * cosLight), 1.0, 2e-3);
+  }
+}
+
+TEST(EmitterGuide, RegionsThatSeeTheirLightKeepEmitterSetSampling) {
+  const RenderScene scene(skylightScene());
+  EmitterGuide guide(scene, true);
+  // Just under the roof beside the opening: the light is hidden, nothing arrives, nothing to learn.
+  // On the roof's light side... (there is no such receiver in the room); so the light's own region:
+  // points between the roof and the light see all of it.
+  const glm::vec3 above(1.2f, 1.2f, 0.5f * (kRoof + kLight));
+  learn(scene, guide, above, 4, 17, guide);
+  EXPECT_EQ(guide.learnedRegionShare(), 0.0f);
+  Uniforms u(19);
+  for (int i = 0; i < 1000; ++i) {
+    const glm::vec2 uPoint = u.next2();
+    const float spare = u.next();
+    const auto a = guide.sample(above, uPoint, [&] { return spare; });
+    const auto b = scene.emitters().sampleStratified(above, uPoint, spare);
+    ASSERT_EQ(a.has_value(), b.has_value());
+    if (a) EXPECT_EQ(a->wi, b->wi);
+  }
+}
+
+// brdf with learning off is the reference; brdf and mis with it on must converge to its image.
+RenderJobSettings renderSettings(SamplingMode mode, bool learnLights) {
+  RenderJobSettings s;
+  s.scenePath = "skylight (built in code)";
+  s.mode = mode;
+  s.width = 16;
+  s.height = 12;
+  s.spp = 512;
+  s.tracer.maxDepth = 6;
+  s.tracer.roulette = RouletteRule::Sqrt;
+  s.tracer.learnLights = learnLights;
+  s.preview.vpl.count = 1024;
+  s.connections.paths = isGuided(mode) ? 64 : 0;
+  return s;
+}
+
+test::BatchEstimate batches(const SceneData& data, const RenderJobSettings& base, uint64_t firstSeed, int* learned) {
+  std::vector<Image> images;
+  for (int b = 0; b < 12; ++b) {
+    RenderJobSettings s = base;
+    s.seed = firstSeed + uint64_t(b);
+    const RenderJobResult r = runRenderJob(s, data);
+    if (r.learnedLightRegions > 0.0) ++*learned;
+    images.push_back(r.image);
+  }
+  return test::estimateFromBatches(images);
+}
+
+TEST(EmitterGuide, PathTracerConvergesToTheSameImageWithLearning) {
+  const SceneData data = skylightScene();
+  int unused = 0, learnedBrdf = 0, learnedMis = 0;
+  const auto reference = batches(data, renderSettings(SamplingMode::Brdf, false), 100, &unused);
+  const auto brdf = batches(data, renderSettings(SamplingMode::Brdf, true), 200, &learnedBrdf);
+  const auto mis = batches(data, renderSettings(SamplingMode::Mis, true), 300, &learnedMis);
+  EXPECT_EQ(learnedBrdf, 12) << "every brdf batch should have learned some region";
+  EXPECT_EQ(learnedMis, 12) << "every mis batch should have learned some region";
+  test::expectAgreement(test::compareEstimates(brdf, reference), "brdf, learning on against off");
+  test::expectAgreement(test::compareEstimates(mis, reference), "mis, learning on against brdf off");
+}
+
+}  // namespace
+}  // namespace vpl
