@@ -2,20 +2,31 @@
 
 #include <algorithm>
 #include <cmath>
+#include "render/sampling/equal_area_map.h"
+#include "render/sampling/warps.h"
 
 namespace vpl {
 
 EmitterGuide::EmitterGuide(const RenderScene& scene, bool enabled) {
   const EmitterSet& emitters = scene.emitters();
-  if (!enabled || !emitters.onlyTriangles() || emitters.triangleCount() > size_t(kMaxTriangles)) return;
-  const size_t triangles = emitters.triangleCount();
+  const size_t triangles = emitters.triangleCount(), punctual = emitters.punctualCount();
+  if (!enabled || emitters.empty() || triangles > size_t(kMaxTriangles) || punctual > size_t(kMaxPunctual)) return;
   // The finest square grid that keeps every triangle's cells within kMaxCells in all.
-  while (triangles * size_t(4 * grid_ * grid_) <= size_t(kMaxCells)) grid_ *= 2;
-  cells_ = int(triangles) * grid_ * grid_;
+  while (triangles > 0 && triangles * size_t(4 * grid_ * grid_) <= size_t(kMaxCells)) grid_ *= 2;
   for (size_t t = 0; t < triangles; ++t) {
     area_.push_back(emitters.triangleArea(t));
-    for (int c = 0; c < grid_ * grid_; ++c) base_.push_back(emitters.trianglePmf(t) / float(grid_ * grid_));
+    for (int c = 0; c < grid_ * grid_; ++c) base_.push_back(emitters.emitterPmf(t) / float(grid_ * grid_));
   }
+  punctualFirst_ = int(base_.size());
+  for (size_t i = 0; i < punctual; ++i) base_.push_back(emitters.emitterPmf(triangles + i));
+  skyFirst_ = int(base_.size());
+  if (emitters.skyIndex() >= 0) {
+    skyPmf_ = emitters.emitterPmf(size_t(emitters.skyIndex()));
+    const int bins = kSkyResolution * kSkyResolution;
+    for (int c = 0; c < bins; ++c) base_.push_back(skyPmf_ / float(bins));
+  }
+  cells_ = int(base_.size());
+  if (cells_ < 2) return;  // one light, one cell: nothing to choose
   // Near-cubic regions, about kTargetRegions of them; a flat box gets one layer along its thin axis.
   low_ = scene.data().boundsMin;
   const glm::vec3 extent = glm::max(scene.data().boundsMax - low_, glm::vec3(0.0f));
@@ -54,8 +65,12 @@ uint32_t EmitterGuide::regionOf(const glm::vec3& p) const {
 }
 
 uint32_t EmitterGuide::slotOf(uint32_t region, const LightSample& s, const glm::vec3& p) const {
-  const size_t t = size_t(s.triangle);
-  return region * uint32_t(cells_) + cellOf(t, scene_->emitters().squareOf(t, p + s.wi * s.distance));
+  const size_t e = size_t(s.emitter);
+  uint32_t cell;
+  if (e < area_.size()) cell = cellOf(e, scene_->emitters().squareOf(e, p + s.wi * s.distance));
+  else if (int(e) == scene_->emitters().skyIndex()) cell = uint32_t(skyFirst_ + equalAreaCell(s.wi, kSkyResolution));
+  else cell = uint32_t(punctualFirst_) + uint32_t(e - area_.size());
+  return region * uint32_t(cells_) + cell;
 }
 
 float EmitterGuide::learnedRegionShare() const {
@@ -107,13 +122,39 @@ std::optional<LightSample> EmitterGuide::sampleLearned(const glm::vec3& p, uint3
   const float low = cell > 0 ? cdf[cell - 1] : 0.0f, width = cdf[cell] - low;
   if (!(width > 0.0f)) return std::nullopt;
   const float x = std::clamp((u.x - low) / width, 0.0f, std::nextafter(1.0f, 0.0f));
+  const uint32_t slot = region * uint32_t(cells_) + cell;
+  if (cell >= uint32_t(skyFirst_)) {
+    // A direction uniform in the sky cell's solid angle (the map preserves area).
+    const uint32_t bin = cell - uint32_t(skyFirst_);
+    const glm::vec2 square = (glm::vec2(float(bin % uint32_t(kSkyResolution)), float(bin / uint32_t(kSkyResolution))) +
+                              glm::vec2(x, u.y)) / float(kSkyResolution);
+    LightSample s;
+    s.wi = glm::normalize(equalAreaSquareToSphere(square));
+    s.radiance = scene_->emitters().sky();
+    s.pdf = width * float(kSkyResolution * kSkyResolution) / (4.0f * kPi);
+    s.emitter = scene_->emitters().skyIndex();
+    s.guideSlot = slot;
+    return s;
+  }
+  if (cell >= uint32_t(punctualFirst_)) {
+    auto s = scene_->emitters().samplePunctual(p, area_.size() + (cell - uint32_t(punctualFirst_)), width);
+    if (s) s->guideSlot = slot;
+    return s;
+  }
   const size_t triangle = cell / uint32_t(grid_ * grid_);
   const uint32_t inTriangle = cell % uint32_t(grid_ * grid_);
   const glm::vec2 square = (glm::vec2(float(inTriangle % uint32_t(grid_)), float(inTriangle / uint32_t(grid_))) +
                             glm::vec2(x, u.y)) / float(grid_);
   auto s = scene_->emitters().sampleTriangleByArea(p, triangle, square, width * float(grid_ * grid_) / area_[triangle]);
-  if (s) s->guideSlot = region * uint32_t(cells_) + cell;
+  if (s) s->guideSlot = slot;
   return s;
+}
+
+float EmitterGuide::pdfSky(const glm::vec3& p, const glm::vec3& wi) const {
+  const uint32_t region = regionOf(p);
+  if (state_[region] != State::Learned) return scene_->emitters().pdfSky(wi);
+  const uint32_t cell = uint32_t(skyFirst_ + equalAreaCell(wi, kSkyResolution));
+  return cellPmf(region, cell) * float(kSkyResolution * kSkyResolution) / (4.0f * kPi);
 }
 
 float EmitterGuide::pdf(const glm::vec3& p, const SurfaceHit& hit) const {
@@ -130,6 +171,12 @@ float EmitterGuide::nextEventPdfTimesCos(const glm::vec3& p, const EmissionSampl
   const EmitterSet& emitters = scene_->emitters();
   const uint32_t region = regionOf(p);
   if (state_[region] != State::Learned) return emitters.nextEventPdfTimesCos(p, e);
+  if (e.emitter >= area_.size()) {
+    // A punctual light: EmitterSet's figure is linear in the choice's probability. (The sky has no
+    // light paths that joins weigh.)
+    const uint32_t cell = uint32_t(punctualFirst_) + (e.emitter - uint32_t(area_.size()));
+    return emitters.nextEventPdfTimesCos(p, e) / emitters.emitterPmf(e.emitter) * cellPmf(region, cell);
+  }
   const glm::vec3 d = p - e.position;
   const float dist2 = glm::dot(d, d);
   if (!(dist2 > 0.0f)) return 0.0f;

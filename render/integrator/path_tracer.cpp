@@ -180,7 +180,12 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
       // Escaped: the sky, weighted against next-event estimation of the sky.
       if (!hit.valid()) {
         if (emitters.hasSky()) {
-          const float w = depth == 0 ? 1.0f : powerHeuristic(path.previousPdf, emitters.pdfSky(ray.direction));
+          float w = 1.0f;
+          if (depth > 0) {
+            const float skyPdf = emitterGuide_ ? emitterGuide_->pdfSky(path.previousPosition, ray.direction)
+                                               : emitters.pdfSky(ray.direction);
+            w = powerHeuristic(path.previousPdf, skyPdf);
+          }
           L += beta * emitters.sky() * w;
         }
         break;

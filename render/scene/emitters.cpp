@@ -213,7 +213,7 @@ std::optional<LightSample> EmitterSet::sampleChosen(const glm::vec3& p, size_t i
       s.pdf = float(double(pmf) / st->solidAngle());
       s.cosLight = std::abs(glm::dot(light.normal, s.wi));
       s.emissionPdf = emissionPdf(light, pmf, s.cosLight);
-      s.triangle = int32_t(index);
+      s.emitter = int32_t(index);
       return s;
     }
     // Sample an emissive triangle by area, convert the density to solid angle at p.
@@ -232,22 +232,31 @@ std::optional<LightSample> EmitterSet::sampleChosen(const glm::vec3& p, size_t i
     s.pdf = pmf * dist2 / (std::abs(cosLight) * light.area);
     s.cosLight = std::abs(cosLight);
     s.emissionPdf = emissionPdf(light, pmf, s.cosLight);
-    s.triangle = int32_t(index);
+    s.emitter = int32_t(index);
     return s;
   }
   if (int(index) == skyIndex_) {
     s.wi = sampleUniformSphere(u);
     s.radiance = sky_;
     s.pdf = pmf * uniformSpherePdf();
+    s.emitter = int32_t(index);
     return s;
   }
+  return samplePunctual(p, index, pmf);
+}
+
+std::optional<LightSample> EmitterSet::samplePunctual(const glm::vec3& p, size_t index, float pmf) const {
+  LightSample s;
+  s.emitter = int32_t(index);
+  // The light path's density is the power choice's, whatever chose the light here.
+  const float powerPmf = distribution_.pmf(index);
   const PunctualLight& light = punctual_[index - triangles_.size()];
   s.delta = true;
   s.pdf = pmf;
   if (light.type == LightType::Directional) {
     s.wi = -glm::normalize(light.direction);
     s.radiance = light.intensity;
-    s.emissionPdf = pmf / (kPi * radius_ * radius_);
+    s.emissionPdf = powerPmf / (kPi * radius_ * radius_);
     return s;
   }
   const glm::vec3 d = light.position - p;
@@ -257,7 +266,7 @@ std::optional<LightSample> EmitterSet::sampleChosen(const glm::vec3& p, size_t i
   s.wi = d / s.distance;
   s.radiance = light.intensity * (spotAttenuation(light, -s.wi) * rangeWindow(light, s.distance) / dist2);
   if (isBlack(s.radiance)) return std::nullopt;
-  s.emissionPdf = pmf * (light.type == LightType::Spot ? uniformConePdf(Cone::fromCos(light.cosOuter)) : uniformSpherePdf());
+  s.emissionPdf = powerPmf * (light.type == LightType::Spot ? uniformConePdf(Cone::fromCos(light.cosOuter)) : uniformSpherePdf());
   return s;
 }
 
@@ -318,7 +327,7 @@ std::optional<LightSample> EmitterSet::sampleTriangleByArea(const glm::vec3& p, 
   s.pdf = areaPdf * dist2 / std::abs(cosLight);
   s.cosLight = std::abs(cosLight);
   s.emissionPdf = emissionPdf(light, distribution_.pmf(index), s.cosLight);
-  s.triangle = int32_t(index);
+  s.emitter = int32_t(index);
   return s;
 }
 

@@ -28,7 +28,7 @@ struct LightSample {
   // (area x solid angle, light choice included), and the cosine at the light (1 for punctual lights).
   float emissionPdf = 0.0f;
   float cosLight = 1.0f;
-  int32_t triangle = -1;  // the emitting triangle's index in the set (-1: another kind of light)
+  int32_t emitter = -1;  // which light of the set (triangles first, then punctual lights, then the sky)
   // EmitterGuide: the part of the emitters the sample came from (its region and cell), for learning.
   uint32_t guideSlot = UINT32_MAX;
 };
@@ -105,9 +105,14 @@ class EmitterSet {
   // What EmitterGuide (render/guide/emitter_guide.h), which learns which part of which emitter
   // each region of the scene sees, builds on: it cuts each triangle's unit square (the domain of
   // sampleUniformTriangle, whose map preserves area) into cells and samples a cell's points by area.
-  bool onlyTriangles() const { return !triangles_.empty() && punctual_.empty() && skyIndex_ < 0; }
-  // The power-proportional probability of choosing emitting triangle `index`.
-  float trianglePmf(size_t index) const { return distribution_.pmf(index); }
+  size_t punctualCount() const { return punctual_.size(); }
+  // The set's index of the sky (after the triangles and punctual lights), or -1.
+  int skyIndex() const { return skyIndex_; }
+  // The power-proportional probability of choosing light `index` of the set.
+  float emitterPmf(size_t index) const { return distribution_.pmf(index); }
+  // Next-event estimation from p towards punctual light `index` of the set, chosen with probability
+  // pmf (its density: the light is a delta).
+  std::optional<LightSample> samplePunctual(const glm::vec3& p, size_t index, float pmf) const;
   float triangleArea(size_t index) const { return triangles_[index].area; }
   glm::vec3 triangleNormal(size_t index) const { return triangles_[index].normal; }
   // The emitter index of a hit's triangle, or -1 where it does not emit.

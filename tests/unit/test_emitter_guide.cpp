@@ -1,8 +1,9 @@
-// Learned next-event estimation (render/guide/emitter_guide.h) on a room lit through a skylight: an
-// emitting quad above a roof with one square opening. What it must keep: the density a sample reports
-// is the one pdf() gives an emitter hit and the one its histogram shows, before and after a region
-// learns; a learned region's samples arrive more often; and the path tracer converges to the same
-// image with learning on and off, in brdf and in mis (whose joins weigh the learned density too).
+// Learned next-event estimation (render/guide/emitter_guide.h) in a closed room lit through one
+// square opening in its roof: by an emitting quad above the roof, or by the uniform sky. What it must
+// keep: the density a sample reports is the one pdf() (pdfSky()) gives an emitter hit (an escaped
+// ray) and the one its histogram shows, before and after a region learns; a learned region's samples
+// arrive more often; and the path tracer converges to the same image with learning on and off, in
+// brdf and, with the quad, in mis (whose joins weigh the learned density too).
 #include <cmath>
 #include <cstdio>
 #include <optional>
@@ -17,9 +18,10 @@ namespace {
 
 constexpr float kRoof = 1.0f, kLight = 1.5f, kHalf = 2.0f, kHole = 0.3f;
 
-// Floor at z = 0 and a roof at z = kRoof over [-kHalf, kHalf]^2, the roof open over [-kHole, kHole]^2;
-// an emitting quad of [-kHalf, kHalf]^2 at z = kLight facing down. Everything else is grey Lambertian.
-SceneData skylightScene() {
+// Floor at z = 0, four walls and a roof at z = kRoof over [-kHalf, kHalf]^2, the roof open over
+// [-kHole, kHole]^2; with `panel`, an emitting quad of [-kHalf, kHalf]^2 at z = kLight facing down
+// (else no light: the renderer's default sky). Everything else is grey Lambertian.
+SceneData skylightScene(bool panel = true) {
   SceneData s;
   Material grey;
   grey.baseColor = glm::vec3(0.5f);
@@ -39,15 +41,26 @@ SceneData skylightScene() {
     m.material = material;
     s.meshes.push_back(m);
   };
-  quad({-kHalf, -kHalf}, {kHalf, kHalf}, kLight, 1, true);  // mesh 0: the light, facing down
-  quad({-kHalf, -kHalf}, {kHalf, kHalf}, 0.0f, 0, false);   // the floor
+  if (panel) quad({-kHalf, -kHalf}, {kHalf, kHalf}, kLight, 1, true);  // mesh 0: the light, facing down
+  quad({-kHalf, -kHalf}, {kHalf, kHalf}, 0.0f, 0, false);             // the floor
+  const auto wall = [&](glm::vec3 a, glm::vec3 b) {  // a vertical rectangle from edge a-b up to the roof
+    MeshData m;
+    m.positions = {a, b, b + glm::vec3(0, 0, kRoof), a + glm::vec3(0, 0, kRoof)};
+    m.indices = {0, 1, 2, 0, 2, 3};
+    m.material = 0;
+    s.meshes.push_back(m);
+  };
+  wall({-kHalf, -kHalf, 0}, {kHalf, -kHalf, 0});
+  wall({kHalf, -kHalf, 0}, {kHalf, kHalf, 0});
+  wall({kHalf, kHalf, 0}, {-kHalf, kHalf, 0});
+  wall({-kHalf, kHalf, 0}, {-kHalf, -kHalf, 0});
   // The roof around the opening, in four strips.
   quad({-kHalf, -kHalf}, {kHalf, -kHole}, kRoof, 0, true);
   quad({-kHalf, kHole}, {kHalf, kHalf}, kRoof, 0, true);
   quad({-kHalf, -kHole}, {-kHole, kHole}, kRoof, 0, true);
   quad({kHole, -kHole}, {kHalf, kHole}, kRoof, 0, true);
   s.boundsMin = glm::vec3(-kHalf, -kHalf, 0.0f);
-  s.boundsMax = glm::vec3(kHalf, kHalf, kLight);
+  s.boundsMax = glm::vec3(kHalf, kHalf, panel ? kLight : kRoof);
   CameraData camera;
   camera.eye = glm::vec3(0.0f, -1.9f, 0.9f);
   camera.target = glm::vec3(0.0f, 0.0f, 0.0f);
@@ -174,6 +187,45 @@ TEST(EmitterGuide, LearnsWhatAnOpeningShowsAndKeepsItsDensityExact) {
   }
 }
 
+// The sky's version: per sample the density equals pdfSky() in its direction, and the histogram over
+// the equal-area map's cells (on which the learned density is constant) follows it.
+void expectSkyDensityIsPdf(const EmitterGuide& guide, const glm::vec3& p, uint64_t seed, const std::string& what) {
+  Uniforms u(seed);
+  for (int i = 0; i < 20000; ++i) {
+    const float spare = u.next();
+    const auto ls = guide.sample(p, u.next2(), [&] { return spare; });
+    ASSERT_TRUE(ls.has_value()) << what;
+    ASSERT_NEAR(guide.pdfSky(p, ls->wi) / ls->pdf, 1.0, 2e-3) << what << ", sample " << i;
+  }
+  Uniforms h(seed + 1);
+  const auto chi = test::chiSquareEqualArea(
+      [&] {
+        const float spare = h.next();
+        const auto ls = guide.sample(p, h.next2(), [&] { return spare; });
+        return ls ? ls->wi : glm::vec3(0.0f);
+      },
+      [&](const glm::vec3& w) { return double(guide.pdfSky(p, w)); }, 300000, EmitterGuide::kSkyResolution);
+  EXPECT_GT(chi.pValue, 1e-3) << what << ": " << chi.report;
+}
+
+TEST(EmitterGuide, LearnsWhereTheSkyShowsAndKeepsItsDensityExact) {
+  const RenderScene scene(skylightScene(false));
+  ASSERT_GE(scene.emitters().skyIndex(), 0) << "a scene without lights gets the default sky";
+  EmitterGuide guide(scene, true);
+  ASSERT_TRUE(guide.active());
+  const glm::vec3 underHole(0.05f, 0.05f, 0.01f);
+  expectSkyDensityIsPdf(guide, underHole, 23, "before learning");
+  const double before = arrivalRate(scene, guide, underHole, 29);
+  learn(scene, guide, underHole, 4, 31, guide);
+  EXPECT_GT(guide.learnedRegionShare(), 0.0f);
+  const double after = arrivalRate(scene, guide, underHole, 29);
+  // The opening is about 0.33 sr of the sphere's 4 pi: 3 % of uniform directions leave through it.
+  EXPECT_LT(before, 0.05);
+  EXPECT_GT(after, 0.3) << "before learning " << before;
+  std::printf("sky samples leaving through the opening: %.3f before learning, %.3f after\n", before, after);
+  expectSkyDensityIsPdf(guide, underHole, 37, "after learning");
+}
+
 TEST(EmitterGuide, RegionsThatSeeTheirLightKeepEmitterSetSampling) {
   const RenderScene scene(skylightScene());
   EmitterGuide guide(scene, true);
@@ -224,7 +276,7 @@ test::BatchEstimate batches(const SceneData& data, const RenderJobSettings& base
 
 TEST(EmitterGuide, PathTracerConvergesToTheSameImageWithLearning) {
   const SceneData data = skylightScene();
-  int unused = 0, learnedBrdf = 0, learnedMis = 0;
+  int unused = 0, learnedBrdf = 0, learnedMis = 0, learnedSky = 0;
   const auto reference = batches(data, renderSettings(SamplingMode::Brdf, false), 100, &unused);
   const auto brdf = batches(data, renderSettings(SamplingMode::Brdf, true), 200, &learnedBrdf);
   const auto mis = batches(data, renderSettings(SamplingMode::Mis, true), 300, &learnedMis);
@@ -232,6 +284,11 @@ TEST(EmitterGuide, PathTracerConvergesToTheSameImageWithLearning) {
   EXPECT_EQ(learnedMis, 12) << "every mis batch should have learned some region";
   test::expectAgreement(test::compareEstimates(brdf, reference), "brdf, learning on against off");
   test::expectAgreement(test::compareEstimates(mis, reference), "mis, learning on against brdf off");
+  const SceneData skyLit = skylightScene(false);
+  const auto skyReference = batches(skyLit, renderSettings(SamplingMode::Brdf, false), 400, &unused);
+  const auto sky = batches(skyLit, renderSettings(SamplingMode::Brdf, true), 500, &learnedSky);
+  EXPECT_EQ(learnedSky, 12) << "every sky-lit batch should have learned some region";
+  test::expectAgreement(test::compareEstimates(sky, skyReference), "brdf under the sky, learning on against off");
 }
 
 }  // namespace
