@@ -82,6 +82,7 @@ struct PanelSettings {
   bool learnGuides;   // guides learn from the paths between passes
   bool vplPrior;      // ... starting from the VPL guide (else from a uniform one)
   bool stratifiedSampler;  // Owen-scrambled Sobol' (else independent random numbers: the paper's)
+  bool learnLights;        // next-event estimation learns which part of which light each region sees
 };
 
 constexpr RouletteRule kRoulettes[] = {RouletteRule::Auto, RouletteRule::Sqrt, RouletteRule::Throughput, RouletteRule::Vpl};
@@ -158,7 +159,8 @@ int runViewer(const ViewerOptions& options) {
                         settings.guide.uniformMutation, rouletteIndex(settings.tracer.roulette),
                         settings.connections.paths != 0, settings.connections.learnChoice, settings.connections.joinsPerVertex,
                         joinDepthIndex(settings.connections.joinDepth),
-                        settings.guide.learnDirections, settings.guide.vplPrior, settings.stratifiedSampler};
+                        settings.guide.learnDirections, settings.guide.vplPrior, settings.stratifiedSampler,
+                        settings.tracer.learnLights};
 
     Image image, variance;
     uint64_t version = 0;
@@ -252,6 +254,8 @@ int runViewer(const ViewerOptions& options) {
         if (stats.joinDepth != SessionStats::kNoJoins)
           ImGui::Text("joins: %s%s", stats.joinDepth < 0 ? "from every vertex" : ("up to depth " + std::to_string(stats.joinDepth)).c_str(),
                       stats.joinDepthTrial ? (stats.joinDepthDecided ? " (auto: measured best)" : " (auto: trying the depths)") : "");
+        if (stats.learnedLightRegions >= 0.0)
+          ImGui::Text("light samples: %.0f %% of the regions learned which lights they see", 100.0 * stats.learnedLightRegions);
         if (isGuided(stats.mode) && stats.learnedGuideShare >= 0.0)
           ImGui::Text("guides: %.0f %% learned from the paths (mean over cache points)", 100.0 * stats.learnedGuideShare);
         if (ImGui::CollapsingHeader("VPLs and guide")) {
@@ -270,6 +274,7 @@ int runViewer(const ViewerOptions& options) {
           ImGui::Checkbox("learn the guides from the paths", &panel.learnGuides);
           ImGui::Checkbox("start learning from the VPL guide", &panel.vplPrior);
           ImGui::Checkbox("stratified sampler (else independent random numbers)", &panel.stratifiedSampler);
+          ImGui::Checkbox("learn which part of which light each region sees", &panel.learnLights);
           if (ImGui::Button("apply (restarts)")) {
             SessionSettings next = settings;
             next.mode = stats.mode;
@@ -290,6 +295,7 @@ int runViewer(const ViewerOptions& options) {
             next.guide.learnDirections = panel.learnGuides;
             next.guide.vplPrior = panel.vplPrior;
             next.stratifiedSampler = panel.stratifiedSampler;
+            next.tracer.learnLights = panel.learnLights;
             session.reset();  // joins the old controller before the new one starts
             session = std::make_unique<ProgressiveSession>(scene, controller.camera(), next);
             settings = next;

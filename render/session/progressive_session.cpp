@@ -395,6 +395,10 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
     }
     if (cancelled()) return;
     ++mine.complete;
+    {
+      std::lock_guard lock(mutex_);
+      stats_.learnedLightRegions = lights ? lights->learnedRegionShare() : -1.0;
+    }
     if (mine.learners) {
       mine.learners->update();
       std::lock_guard lock(mutex_);

@@ -71,6 +71,7 @@ struct SessionStats {
   bool rouletteWindow = false;  // the film shown uses the VPL weight window (--roulette vpl, or auto switched)
   double learnedBsdfProbability = -1.0;  // mis: mean learned BSDF probability over cache points (-1: none yet)
   double learnedGuideShare = -1.0;       // learned guides: mean weight of the learned part against the prior (-1: off)
+  double learnedLightRegions = -1.0;     // learned next-event estimation: the share of regions that learned (-1: off)
   static constexpr int kNoJoins = -100;
   int joinDepth = kNoJoins;               // VPL connections: the depth the last pass joined to (-1: every vertex)
   bool joinDepthTrial = false, joinDepthDecided = false;  // --join-depth auto: trying, or decided
