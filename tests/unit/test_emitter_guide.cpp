@@ -274,21 +274,26 @@ test::BatchEstimate batches(const SceneData& data, const RenderJobSettings& base
   return test::estimateFromBatches(images);
 }
 
-TEST(EmitterGuide, PathTracerConvergesToTheSameImageWithLearning) {
-  const SceneData data = skylightScene();
-  int unused = 0, learnedBrdf = 0, learnedMis = 0, learnedSky = 0;
-  const auto reference = batches(data, renderSettings(SamplingMode::Brdf, false), 100, &unused);
-  const auto brdf = batches(data, renderSettings(SamplingMode::Brdf, true), 200, &learnedBrdf);
-  const auto mis = batches(data, renderSettings(SamplingMode::Mis, true), 300, &learnedMis);
-  EXPECT_EQ(learnedBrdf, 12) << "every brdf batch should have learned some region";
-  EXPECT_EQ(learnedMis, 12) << "every mis batch should have learned some region";
-  test::expectAgreement(test::compareEstimates(brdf, reference), "brdf, learning on against off");
-  test::expectAgreement(test::compareEstimates(mis, reference), "mis, learning on against brdf off");
-  const SceneData skyLit = skylightScene(false);
-  const auto skyReference = batches(skyLit, renderSettings(SamplingMode::Brdf, false), 400, &unused);
-  const auto sky = batches(skyLit, renderSettings(SamplingMode::Brdf, true), 500, &learnedSky);
-  EXPECT_EQ(learnedSky, 12) << "every sky-lit batch should have learned some region";
-  test::expectAgreement(test::compareEstimates(sky, skyReference), "brdf under the sky, learning on against off");
+// `mode` with learning converges to brdf without it, pixel by pixel; every batch learned some region.
+void expectLearningConvergesToBrdf(const SceneData& data, SamplingMode mode, uint64_t seed, const std::string& what) {
+  int unused = 0, learned = 0;
+  const auto reference = batches(data, renderSettings(SamplingMode::Brdf, false), seed, &unused);
+  const auto learning = batches(data, renderSettings(mode, true), seed + 100, &learned);
+  EXPECT_EQ(learned, 12) << what << ": every batch should have learned some region";
+  test::expectAgreement(test::compareEstimates(learning, reference), what);
+}
+
+TEST(EmitterGuide, BrdfConvergesToTheSameImageWithLearning) {
+  expectLearningConvergesToBrdf(skylightScene(), SamplingMode::Brdf, 100, "brdf, learning on against off");
+}
+
+// The joins weigh the learned density at their light paths' first vertices.
+TEST(EmitterGuide, MisConvergesToBrdfWithLearning) {
+  expectLearningConvergesToBrdf(skylightScene(), SamplingMode::Mis, 300, "mis, learning on against brdf off");
+}
+
+TEST(EmitterGuide, BrdfUnderTheSkyConvergesToTheSameImageWithLearning) {
+  expectLearningConvergesToBrdf(skylightScene(false), SamplingMode::Brdf, 500, "brdf under the sky, learning on against off");
 }
 
 }  // namespace
