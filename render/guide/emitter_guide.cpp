@@ -38,18 +38,31 @@ EmitterGuide::EmitterGuide(const RenderScene& scene, bool enabled) {
   perUnit_ = glm::vec3(regionsPerAxis_) / safe;
   const size_t regionCount = size_t(regionsPerAxis_.x) * size_t(regionsPerAxis_.y) * size_t(regionsPerAxis_.z);
   state_.assign(regionCount, State::Undecided);
-  cdf_.assign(regionCount * size_t(cells_), 0.0f);
-  sums_.assign(regionCount * size_t(cells_), 0.0);
+  tables_.resize(regionCount);
   attempts_.assign(regionCount, 0);
   arrivals_.assign(regionCount, 0);
   lanes_ = std::vector<Lane>(kLanes);
   for (Lane& l : lanes_) {
-    l.sums = std::vector<std::atomic<uint64_t>>(regionCount * size_t(cells_));
+    l.sums = std::vector<std::atomic<std::atomic<uint64_t>*>>(regionCount);
     l.attempts = std::vector<std::atomic<uint64_t>>(regionCount);
     l.arrivals = std::vector<std::atomic<uint64_t>>(regionCount);
     l.touched = std::vector<std::atomic<uint8_t>>(regionCount);
   }
   scene_ = &scene;
+}
+
+std::atomic<uint64_t>* EmitterGuide::Lane::sumsOf(uint32_t region, size_t cells) {
+  std::atomic<uint64_t>* block = sums[region].load(std::memory_order_acquire);
+  if (block) return block;
+  auto* made = new std::atomic<uint64_t>[cells]();
+  // Two threads of one lane may race to make it: one block wins, the other is freed unused.
+  if (sums[region].compare_exchange_strong(block, made, std::memory_order_acq_rel)) return made;
+  delete[] made;
+  return block;
+}
+
+EmitterGuide::Lane::~Lane() {
+  for (auto& block : sums) delete[] block.load(std::memory_order_relaxed);
 }
 
 EmitterGuide::Lane& EmitterGuide::lane() const {
@@ -82,41 +95,57 @@ void EmitterGuide::learnFromLastPass() {
   if (!active()) return;
   for (size_t r = 0; r < state_.size(); ++r) {
     if (state_[r] == State::Default) continue;
-    bool touched = false;
+    // Plain loads first: a locked exchange on every region of every lane each pass cost more than
+    // the passes of a small render.
+    const auto take = [](auto& counter) {
+      return counter.load(std::memory_order_relaxed) != 0 ? counter.exchange(0, std::memory_order_relaxed) : 0;
+    };
+    bool touched = false, attempted = false;
     for (Lane& l : lanes_) {
-      attempts_[r] += l.attempts[r].exchange(0, std::memory_order_relaxed);
-      arrivals_[r] += l.arrivals[r].exchange(0, std::memory_order_relaxed);
-      touched |= l.touched[r].exchange(0, std::memory_order_relaxed) != 0;
+      const uint64_t a = take(l.attempts[r]);
+      attempts_[r] += a;
+      attempted |= a > 0;
+      arrivals_[r] += take(l.arrivals[r]);
+      touched |= take(l.touched[r]) != 0;
     }
-    double* sums = &sums_[r * size_t(cells_)];
-    double total = 0.0;
-    for (int c = 0; c < cells_; ++c) {
-      uint64_t sum = 0;
-      if (touched)
-        for (Lane& l : lanes_) sum += l.sums[r * size_t(cells_) + size_t(c)].exchange(0, std::memory_order_relaxed);
-      sums[c] += double(sum) / double(kFixedPoint);
-      total += sums[c];
+    if (!touched && !attempted) continue;  // nothing new here (most of the box, every pass)
+    // An undecided region's sums wait in the lanes until it decides: folding them every pass was most
+    // of a small render's time.
+    const bool deciding = state_[r] == State::Undecided && attempts_[r] >= kMinAttempts;
+    if ((touched && state_[r] == State::Learned) || deciding) {
+      if (!tables_[r]) tables_[r] = std::make_unique<Table>(Table{std::vector<double>(size_t(cells_), 0.0), 0.0, {}});
+      Table& t = *tables_[r];
+      for (Lane& l : lanes_) {
+        std::atomic<uint64_t>* block = l.sums[r].load(std::memory_order_acquire);
+        if (!block) continue;
+        for (int c = 0; c < cells_; ++c) {
+          const double sum = double(take(block[c])) / double(kFixedPoint);
+          t.sums[size_t(c)] += sum;
+          t.total += sum;
+        }
+      }
     }
     // The switch, once: to learning where most light samples were wasted and something arrived.
     bool switched = false;
-    if (state_[r] == State::Undecided && attempts_[r] >= kMinAttempts) {
+    if (deciding) {
       const bool wasted = double(arrivals_[r]) < double(kArrivalShare) * double(attempts_[r]);
-      state_[r] = wasted && total > 0.0 ? State::Learned : State::Default;
+      state_[r] = wasted && tables_[r]->total > 0.0 ? State::Learned : State::Default;
       switched = state_[r] == State::Learned;
     }
     if (state_[r] != State::Learned || !(touched || switched)) continue;
-    float* cdf = &cdf_[r * size_t(cells_)];
+    Table& t = *tables_[r];
+    t.cdf.resize(size_t(cells_));
     double cumulative = 0.0;
     for (int c = 0; c < cells_; ++c) {
-      cumulative += double(kBaseShare) * double(base_[size_t(c)]) + (1.0 - double(kBaseShare)) * sums[c] / total;
-      cdf[c] = float(cumulative);
+      cumulative += double(kBaseShare) * double(base_[size_t(c)]) + (1.0 - double(kBaseShare)) * t.sums[size_t(c)] / t.total;
+      t.cdf[size_t(c)] = float(cumulative);
     }
-    cdf[cells_ - 1] = 1.0f;
+    t.cdf.back() = 1.0f;
   }
 }
 
 std::optional<LightSample> EmitterGuide::sampleLearned(const glm::vec3& p, uint32_t region, glm::vec2 u) const {
-  const float* cdf = &cdf_[size_t(region) * size_t(cells_)];
+  const float* cdf = tables_[region]->cdf.data();
   // The first cell whose cumulative probability passes u.x; u.x rescaled within it serves the point.
   const uint32_t cell = uint32_t(std::min(int(std::upper_bound(cdf, cdf + cells_, u.x) - cdf), cells_ - 1));
   const float low = cell > 0 ? cdf[cell - 1] : 0.0f, width = cdf[cell] - low;

@@ -30,6 +30,7 @@
 #pragma once
 #include <atomic>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <vector>
 #include <glm/glm.hpp>
@@ -92,7 +93,9 @@ class EmitterGuide {
     const uint32_t region = slot / uint32_t(cells_);
     if (state_[region] == State::Undecided) l.arrivals[region].fetch_add(1, std::memory_order_relaxed);
     if (!l.touched[region].load(std::memory_order_relaxed)) l.touched[region].store(1, std::memory_order_relaxed);
-    if (value > 0.0f) l.sums[slot].fetch_add(uint64_t(std::min(value, kLargestRecord) * kFixedPoint), std::memory_order_relaxed);
+    if (value > 0.0f)
+      l.sumsOf(region, size_t(cells_))[slot % uint32_t(cells_)].fetch_add(uint64_t(std::min(value, kLargestRecord) * kFixedPoint),
+                                                                          std::memory_order_relaxed);
   }
   // The share of regions that sample from what they learned.
   float learnedRegionShare() const;
@@ -105,10 +108,20 @@ class EmitterGuide {
   // This pass's records, in kLanes copies: the threads record into different lanes (by the order
   // in which they first record), so that two cores do not pass the same cache lines back and forth.
   static constexpr size_t kLanes = 2;  // the 2-core machines measured; more threads share them (atomics)
+  // A region's per-cell sums are made when a sample first records there (most of a scene's box holds
+  // no surface, and a render job of a few pixels must not pay for tables it never touches).
   struct Lane {
-    std::vector<std::atomic<uint64_t>> sums;                 // per region, per cell
+    std::vector<std::atomic<std::atomic<uint64_t>*>> sums;  // per region: its cells' sums, or null
     std::vector<std::atomic<uint64_t>> attempts, arrivals;  // per region
     std::vector<std::atomic<uint8_t>> touched;               // per region: any sum this pass
+    std::atomic<uint64_t>* sumsOf(uint32_t region, size_t cells);
+    ~Lane();
+  };
+  // What a region has learned over every pass so far (made when it first records).
+  struct Table {
+    std::vector<double> sums;  // per cell
+    double total = 0.0;
+    std::vector<float> cdf;    // per cell, cumulative, the last exactly 1 (learned regions)
   };
 
   uint32_t regionOf(const glm::vec3& p) const;
@@ -120,7 +133,7 @@ class EmitterGuide {
   uint32_t slotOf(uint32_t region, const LightSample& s, const glm::vec3& p) const;
   // The probability that learned region r picks `cell`.
   float cellPmf(uint32_t region, uint32_t cell) const {
-    const float* cdf = &cdf_[size_t(region) * size_t(cells_)];
+    const float* cdf = tables_[region]->cdf.data();
     return cdf[cell] - (cell > 0 ? cdf[cell - 1] : 0.0f);
   }
   // Area density of the point at `square` of triangle t in learned region r.
@@ -141,8 +154,7 @@ class EmitterGuide {
   float skyPmf_ = 0.0f;           // EmitterSet's probability of choosing the sky
   enum class State : uint8_t { Undecided, Default, Learned };
   std::vector<State> state_;      // per region: Learned samples from its table, the others as EmitterSet
-  std::vector<float> cdf_;        // per region, per cell: cumulative, the last exactly 1 (learned regions)
-  std::vector<double> sums_;      // per region, per cell: every pass so far
+  std::vector<std::unique_ptr<Table>> tables_;  // per region: null until it records
   std::vector<uint64_t> attempts_, arrivals_;  // per region: every pass so far
   mutable std::vector<Lane> lanes_;
 };
