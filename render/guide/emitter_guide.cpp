@@ -10,20 +10,18 @@ namespace vpl {
 EmitterGuide::EmitterGuide(const RenderScene& scene, bool enabled) {
   const EmitterSet& emitters = scene.emitters();
   const size_t triangles = emitters.triangleCount(), punctual = emitters.punctualCount();
+  triangles_ = triangles;
   if (!enabled || emitters.empty() || triangles > size_t(kMaxTriangles) || punctual > size_t(kMaxPunctual)) return;
   // The finest square grid that keeps every triangle's cells within kMaxCells in all.
   while (triangles > 0 && triangles * size_t(4 * grid_ * grid_) <= size_t(kMaxCells)) grid_ *= 2;
-  for (size_t t = 0; t < triangles; ++t) {
-    area_.push_back(emitters.triangleArea(t));
+  for (size_t t = 0; t < triangles; ++t)
     for (int c = 0; c < grid_ * grid_; ++c) base_.push_back(emitters.emitterPmf(t) / float(grid_ * grid_));
-  }
   punctualFirst_ = int(base_.size());
   for (size_t i = 0; i < punctual; ++i) base_.push_back(emitters.emitterPmf(triangles + i));
   skyFirst_ = int(base_.size());
   if (emitters.skyIndex() >= 0) {
-    skyPmf_ = emitters.emitterPmf(size_t(emitters.skyIndex()));
     const int bins = kSkyResolution * kSkyResolution;
-    for (int c = 0; c < bins; ++c) base_.push_back(skyPmf_ / float(bins));
+    for (int c = 0; c < bins; ++c) base_.push_back(emitters.emitterPmf(size_t(emitters.skyIndex())) / float(bins));
   }
   cells_ = int(base_.size());
   if (cells_ < 2) return;  // one light, one cell: nothing to choose
@@ -80,9 +78,9 @@ uint32_t EmitterGuide::regionOf(const glm::vec3& p) const {
 uint32_t EmitterGuide::slotOf(uint32_t region, const LightSample& s, const glm::vec3& p) const {
   const size_t e = size_t(s.emitter);
   uint32_t cell;
-  if (e < area_.size()) cell = cellOf(e, scene_->emitters().squareOf(e, p + s.wi * s.distance));
+  if (e < triangles_) cell = cellOf(e, scene_->emitters().squareOf(e, p + s.wi * s.distance));
   else if (int(e) == scene_->emitters().skyIndex()) cell = uint32_t(skyFirst_ + equalAreaCell(s.wi, kSkyResolution));
-  else cell = uint32_t(punctualFirst_) + uint32_t(e - area_.size());
+  else cell = uint32_t(punctualFirst_) + uint32_t(e - triangles_);
   return region * uint32_t(cells_) + cell;
 }
 
@@ -166,7 +164,7 @@ std::optional<LightSample> EmitterGuide::sampleLearned(const glm::vec3& p, uint3
     return s;
   }
   if (cell >= uint32_t(punctualFirst_)) {
-    auto s = scene_->emitters().samplePunctual(p, area_.size() + (cell - uint32_t(punctualFirst_)), width);
+    auto s = scene_->emitters().samplePunctual(p, triangles_ + (cell - uint32_t(punctualFirst_)), width);
     if (s) s->guideSlot = slot;
     return s;
   }
@@ -174,7 +172,7 @@ std::optional<LightSample> EmitterGuide::sampleLearned(const glm::vec3& p, uint3
   const uint32_t inTriangle = cell % uint32_t(grid_ * grid_);
   const glm::vec2 square = (glm::vec2(float(inTriangle % uint32_t(grid_)), float(inTriangle / uint32_t(grid_))) +
                             glm::vec2(x, u.y)) / float(grid_);
-  auto s = scene_->emitters().sampleTriangleByArea(p, triangle, square, width * float(grid_ * grid_) / area_[triangle]);
+  auto s = scene_->emitters().sampleTriangleByArea(p, triangle, square, width * float(grid_ * grid_));
   if (s) s->guideSlot = slot;
   return s;
 }
@@ -192,18 +190,18 @@ float EmitterGuide::pdf(const glm::vec3& p, const SurfaceHit& hit) const {
   if (state_[region] != State::Learned) return emitters.pdfTriangle(p, hit);
   const int32_t t = emitters.emitterOf(hit);
   if (t < 0) return 0.0f;
-  const float area = areaPdf(region, size_t(t), emitters.squareOf(size_t(t), hit.position));
-  return emitters.solidAnglePdfOfArea(p, size_t(t), hit.position, hit.geometricNormal, hit.frontFace, area);
+  const float choice = triangleChoice(region, size_t(t), emitters.squareOf(size_t(t), hit.position));
+  return emitters.solidAnglePdfOfArea(p, size_t(t), hit.position, hit.geometricNormal, hit.frontFace, choice);
 }
 
 float EmitterGuide::nextEventPdfTimesCos(const glm::vec3& p, const EmissionSample& e) const {
   const EmitterSet& emitters = scene_->emitters();
   const uint32_t region = regionOf(p);
   if (state_[region] != State::Learned) return emitters.nextEventPdfTimesCos(p, e);
-  if (e.emitter >= area_.size()) {
+  if (e.emitter >= triangles_) {
     // A punctual light: EmitterSet's figure is linear in the choice's probability. (The sky has no
     // light paths that joins weigh.)
-    const uint32_t cell = uint32_t(punctualFirst_) + (e.emitter - uint32_t(area_.size()));
+    const uint32_t cell = uint32_t(punctualFirst_) + (e.emitter - uint32_t(triangles_));
     return emitters.nextEventPdfTimesCos(p, e) / emitters.emitterPmf(e.emitter) * cellPmf(region, cell);
   }
   const glm::vec3 d = p - e.position;
@@ -211,7 +209,7 @@ float EmitterGuide::nextEventPdfTimesCos(const glm::vec3& p, const EmissionSampl
   if (!(dist2 > 0.0f)) return 0.0f;
   const bool front = glm::dot(e.normal, emitters.triangleNormal(e.emitter)) > 0.0f;
   const float solidAngle = emitters.solidAnglePdfOfArea(p, e.emitter, e.position, e.normal, front,
-                                                        areaPdf(region, e.emitter, e.square));
+                                                        triangleChoice(region, e.emitter, e.square));
   return solidAngle * std::abs(glm::dot(e.normal, d)) / std::sqrt(dist2);
 }
 

@@ -136,9 +136,10 @@ class EmitterGuide {
     const float* cdf = tables_[region]->cdf.data();
     return cdf[cell] - (cell > 0 ? cdf[cell - 1] : 0.0f);
   }
-  // Area density of the point at `square` of triangle t in learned region r.
-  float areaPdf(uint32_t region, size_t triangle, glm::vec2 square) const {
-    return cellPmf(region, cellOf(triangle, square)) * float(grid_ * grid_) / area_[triangle];
+  // The probability of triangle t that gives its point at `square` the density learned region r
+  // samples it with (EmitterSet::sampleTriangleByArea's `choice`: the cell's, times its cells).
+  float triangleChoice(uint32_t region, size_t triangle, glm::vec2 square) const {
+    return cellPmf(region, cellOf(triangle, square)) * float(grid_ * grid_);
   }
   std::optional<LightSample> sampleLearned(const glm::vec3& p, uint32_t region, glm::vec2 u) const;
   Lane& lane() const;
@@ -149,9 +150,8 @@ class EmitterGuide {
   int punctualFirst_ = 0, skyFirst_ = 0;  // the first cells of punctual lights and of the sky
   glm::ivec3 regionsPerAxis_{1};
   glm::vec3 low_{0.0f}, perUnit_{0.0f};
-  std::vector<float> area_;       // per triangle
+  size_t triangles_ = 0;          // emitting triangles (the first lights of the set)
   std::vector<float> base_;       // per cell: the power choice
-  float skyPmf_ = 0.0f;           // EmitterSet's probability of choosing the sky
   enum class State : uint8_t { Undecided, Default, Learned };
   std::vector<State> state_;      // per region: Learned samples from its table, the others as EmitterSet
   std::vector<std::unique_ptr<Table>> tables_;  // per region: null until it records

@@ -216,24 +216,7 @@ std::optional<LightSample> EmitterSet::sampleChosen(const glm::vec3& p, size_t i
       s.emitter = int32_t(index);
       return s;
     }
-    // Sample an emissive triangle by area, convert the density to solid angle at p.
-    const glm::vec2 b = sampleUniformTriangle(u);
-    const TrianglePoint tp = trianglePoint(light, b);
-    const glm::vec3 x = tp.position, n = tp.normal;
-    const glm::vec3 d = x - p;
-    const float dist2 = glm::dot(d, d);
-    if (!(dist2 > 0.0f)) return std::nullopt;
-    s.distance = std::sqrt(dist2);
-    s.wi = d / s.distance;
-    const float cosLight = -glm::dot(n, s.wi);
-    if (std::abs(cosLight) < 1e-7f) return std::nullopt;
-    s.radiance = triangleRadiance(light, b, cosLight > 0.0f);
-    if (isBlack(s.radiance)) return std::nullopt;
-    s.pdf = pmf * dist2 / (std::abs(cosLight) * light.area);
-    s.cosLight = std::abs(cosLight);
-    s.emissionPdf = emissionPdf(light, pmf, s.cosLight);
-    s.emitter = int32_t(index);
-    return s;
+    return sampleTrianglePoint(p, index, u, pmf);
   }
   if (int(index) == skyIndex_) {
     s.wi = sampleUniformSphere(u);
@@ -283,11 +266,7 @@ float EmitterSet::pdfTrianglePoint(const glm::vec3& p, size_t index, const glm::
   if (!front && !light.twoSided) return 0.0f;
   if (std::isnan(planeDistance(p, light))) return 0.0f;  // sample() sends nothing from there
   if (const auto st = solidAngleStrategy(p, light)) return float(double(distribution_.pmf(index)) / st->solidAngle());
-  const glm::vec3 d = x - p;
-  const float dist2 = glm::dot(d, d);
-  const float cosLight = std::abs(glm::dot(normal, d)) / std::sqrt(dist2);
-  if (!(cosLight > 1e-7f)) return 0.0f;
-  return distribution_.pmf(index) * dist2 / (cosLight * light.area);
+  return areaToSolidAngle(p, index, x, normal, distribution_.pmf(index));
 }
 
 int32_t EmitterSet::emitterOf(const SurfaceHit& hit) const {
@@ -308,11 +287,9 @@ glm::vec2 EmitterSet::squareOf(size_t index, const glm::vec3& x) const {
   return glm::clamp(s, glm::vec2(0.0f), glm::vec2(std::nextafter(1.0f, 0.0f)));
 }
 
-std::optional<LightSample> EmitterSet::sampleTriangleByArea(const glm::vec3& p, size_t index, glm::vec2 square,
-                                                            float areaPdf) const {
+std::optional<LightSample> EmitterSet::sampleTrianglePoint(const glm::vec3& p, size_t index, glm::vec2 square,
+                                                           float choice) const {
   const TriangleLight& light = triangles_[index];
-  const float h = planeDistance(p, light);
-  if (std::isnan(h) || (h < 0.0f && !light.twoSided)) return std::nullopt;
   const glm::vec2 b = sampleUniformTriangle(square);
   const glm::vec3 d = trianglePoint(light, b).position - p;
   const float dist2 = glm::dot(d, d);
@@ -321,26 +298,39 @@ std::optional<LightSample> EmitterSet::sampleTriangleByArea(const glm::vec3& p, 
   s.distance = std::sqrt(dist2);
   s.wi = d / s.distance;
   const float cosLight = -glm::dot(light.normal, s.wi);
-  if (!(std::abs(cosLight) > 1e-7f)) return std::nullopt;
+  if (std::abs(cosLight) < 1e-7f) return std::nullopt;
   s.radiance = triangleRadiance(light, b, cosLight > 0.0f);
   if (isBlack(s.radiance)) return std::nullopt;
-  s.pdf = areaPdf * dist2 / std::abs(cosLight);
+  s.pdf = choice * dist2 / (std::abs(cosLight) * light.area);
   s.cosLight = std::abs(cosLight);
   s.emissionPdf = emissionPdf(light, distribution_.pmf(index), s.cosLight);
   s.emitter = int32_t(index);
   return s;
 }
 
-float EmitterSet::solidAnglePdfOfArea(const glm::vec3& p, size_t index, const glm::vec3& x, const glm::vec3& normal,
-                                      bool front, float areaPdf) const {
+std::optional<LightSample> EmitterSet::sampleTriangleByArea(const glm::vec3& p, size_t index, glm::vec2 square,
+                                                            float choice) const {
   const TriangleLight& light = triangles_[index];
-  if (!front && !light.twoSided) return 0.0f;
-  if (std::isnan(planeDistance(p, light))) return 0.0f;
+  const float h = planeDistance(p, light);
+  if (std::isnan(h) || (h < 0.0f && !light.twoSided)) return std::nullopt;
+  return sampleTrianglePoint(p, index, square, choice);
+}
+
+float EmitterSet::areaToSolidAngle(const glm::vec3& p, size_t index, const glm::vec3& x, const glm::vec3& normal,
+                                   float choice) const {
   const glm::vec3 d = x - p;
   const float dist2 = glm::dot(d, d);
   const float cosLight = std::abs(glm::dot(normal, d)) / std::sqrt(dist2);
   if (!(cosLight > 1e-7f)) return 0.0f;
-  return areaPdf * dist2 / cosLight;
+  return choice * dist2 / (cosLight * triangles_[index].area);
+}
+
+float EmitterSet::solidAnglePdfOfArea(const glm::vec3& p, size_t index, const glm::vec3& x, const glm::vec3& normal,
+                                      bool front, float choice) const {
+  const TriangleLight& light = triangles_[index];
+  if (!front && !light.twoSided) return 0.0f;
+  if (std::isnan(planeDistance(p, light))) return 0.0f;
+  return areaToSolidAngle(p, index, x, normal, choice);
 }
 
 float EmitterSet::emissionPdf(const TriangleLight& light, float pmf, float cosLight) {

@@ -113,19 +113,19 @@ class EmitterSet {
   // Next-event estimation from p towards punctual light `index` of the set, chosen with probability
   // pmf (its density: the light is a delta).
   std::optional<LightSample> samplePunctual(const glm::vec3& p, size_t index, float pmf) const;
-  float triangleArea(size_t index) const { return triangles_[index].area; }
   glm::vec3 triangleNormal(size_t index) const { return triangles_[index].normal; }
   // The emitter index of a hit's triangle, or -1 where it does not emit.
   int32_t emitterOf(const SurfaceHit& hit) const;
   // The unit square's point that sampleUniformTriangle maps to x, a point of triangle `index`.
   glm::vec2 squareOf(size_t index, const glm::vec3& x) const;
   // Next-event estimation from p towards the point of triangle `index` at `square`, a point drawn
-  // with density areaPdf (per unit area of the triangle, every choice included).
-  std::optional<LightSample> sampleTriangleByArea(const glm::vec3& p, size_t index, glm::vec2 square, float areaPdf) const;
-  // The solid-angle density at p of area density areaPdf at point x of triangle `index` (facing
-  // `normal`, hit on side `front`): 0 where sampleTriangleByArea would send nothing.
+  // with density choice / area (per unit area of the triangle: as if the triangle were chosen with
+  // probability `choice` and its point uniformly, which is what sample() does by area).
+  std::optional<LightSample> sampleTriangleByArea(const glm::vec3& p, size_t index, glm::vec2 square, float choice) const;
+  // The solid-angle density at p of that density at point x of triangle `index` (facing `normal`,
+  // hit on side `front`): 0 where sampleTriangleByArea would send nothing.
   float solidAnglePdfOfArea(const glm::vec3& p, size_t index, const glm::vec3& x, const glm::vec3& normal, bool front,
-                            float areaPdf) const;
+                            float choice) const;
 
   // Emitted radiance of a surface hit towards wo (0 unless the material emits on that side).
   glm::vec3 emitted(const SurfaceHit& hit, const glm::vec3& wo) const;
@@ -168,6 +168,9 @@ class EmitterSet {
   std::optional<EmissionSample> sampleEmissionChosen(size_t index, float pmf, float uSide, glm::vec2 uPos, glm::vec2 uDir) const;
   // sampleStratified() where foldsChoice().
   std::optional<LightSample> sampleFolded(const glm::vec3& p, glm::vec2 u) const;
+  // sampleTriangleByArea() and solidAnglePdfOfArea() once p is known to see the triangle's lit side.
+  std::optional<LightSample> sampleTrianglePoint(const glm::vec3& p, size_t index, glm::vec2 square, float choice) const;
+  float areaToSolidAngle(const glm::vec3& p, size_t index, const glm::vec3& x, const glm::vec3& normal, float choice) const;
   // sample() once the emitter `index` is chosen with probability pmf.
   std::optional<LightSample> sampleChosen(const glm::vec3& p, size_t index, float pmf, glm::vec2 u) const;
   // The spherical triangle of `light` seen from p when sample() samples it by solid angle from
