@@ -10,7 +10,6 @@ namespace vpl {
 EmitterGuide::EmitterGuide(const RenderScene& scene, bool enabled) {
   const EmitterSet& emitters = scene.emitters();
   const size_t triangles = emitters.triangleCount(), punctual = emitters.punctualCount();
-  triangles_ = triangles;
   if (!enabled || emitters.empty() || triangles > size_t(kMaxTriangles) || punctual > size_t(kMaxPunctual)) return;
   // The finest square grid that keeps every triangle's cells within kMaxCells in all.
   while (triangles > 0 && triangles * size_t(4 * grid_ * grid_) <= size_t(kMaxCells)) grid_ *= 2;
@@ -78,9 +77,10 @@ uint32_t EmitterGuide::regionOf(const glm::vec3& p) const {
 uint32_t EmitterGuide::slotOf(uint32_t region, const LightSample& s, const glm::vec3& p) const {
   const size_t e = size_t(s.emitter);
   uint32_t cell;
-  if (e < triangles_) cell = cellOf(e, scene_->emitters().squareOf(e, p + s.wi * s.distance));
+  const size_t triangles = scene_->emitters().triangleCount();
+  if (e < triangles) cell = cellOf(e, scene_->emitters().squareOf(e, p + s.wi * s.distance));
   else if (int(e) == scene_->emitters().skyIndex()) cell = uint32_t(skyFirst_ + equalAreaCell(s.wi, kSkyResolution));
-  else cell = uint32_t(punctualFirst_) + uint32_t(e - triangles_);
+  else cell = uint32_t(punctualFirst_) + uint32_t(e - triangles);
   return region * uint32_t(cells_) + cell;
 }
 
@@ -89,15 +89,21 @@ float EmitterGuide::learnedRegionShare() const {
   return float(double(std::count(state_.begin(), state_.end(), State::Learned)) / double(state_.size()));
 }
 
+namespace {
+
+// A lane's counter, emptied. A plain load first: a locked exchange on every region of every lane each
+// pass cost more than the passes of a small render.
+template <class T>
+T take(std::atomic<T>& counter) {
+  return counter.load(std::memory_order_relaxed) != 0 ? counter.exchange(0, std::memory_order_relaxed) : T(0);
+}
+
+}  // namespace
+
 void EmitterGuide::learnFromLastPass() {
   if (!active()) return;
   for (size_t r = 0; r < state_.size(); ++r) {
     if (state_[r] == State::Default) continue;
-    // Plain loads first: a locked exchange on every region of every lane each pass cost more than
-    // the passes of a small render.
-    const auto take = [](auto& counter) {
-      return counter.load(std::memory_order_relaxed) != 0 ? counter.exchange(0, std::memory_order_relaxed) : 0;
-    };
     bool touched = false, attempted = false;
     for (Lane& l : lanes_) {
       const uint64_t a = take(l.attempts[r]);
@@ -164,7 +170,7 @@ std::optional<LightSample> EmitterGuide::sampleLearned(const glm::vec3& p, uint3
     return s;
   }
   if (cell >= uint32_t(punctualFirst_)) {
-    auto s = scene_->emitters().samplePunctual(p, triangles_ + (cell - uint32_t(punctualFirst_)), width);
+    auto s = scene_->emitters().samplePunctual(p, scene_->emitters().triangleCount() + (cell - uint32_t(punctualFirst_)), width);
     if (s) s->guideSlot = slot;
     return s;
   }
@@ -198,10 +204,10 @@ float EmitterGuide::nextEventPdfTimesCos(const glm::vec3& p, const EmissionSampl
   const EmitterSet& emitters = scene_->emitters();
   const uint32_t region = regionOf(p);
   if (state_[region] != State::Learned) return emitters.nextEventPdfTimesCos(p, e);
-  if (e.emitter >= triangles_) {
+  if (e.emitter >= emitters.triangleCount()) {
     // A punctual light: EmitterSet's figure is linear in the choice's probability. (The sky has no
     // light paths that joins weigh.)
-    const uint32_t cell = uint32_t(punctualFirst_) + (e.emitter - uint32_t(triangles_));
+    const uint32_t cell = uint32_t(punctualFirst_) + uint32_t(e.emitter - emitters.triangleCount());
     return emitters.nextEventPdfTimesCos(p, e) / emitters.emitterPmf(e.emitter) * cellPmf(region, cell);
   }
   const glm::vec3 d = p - e.position;

@@ -150,7 +150,6 @@ class EmitterGuide {
   int punctualFirst_ = 0, skyFirst_ = 0;  // the first cells of punctual lights and of the sky
   glm::ivec3 regionsPerAxis_{1};
   glm::vec3 low_{0.0f}, perUnit_{0.0f};
-  size_t triangles_ = 0;          // emitting triangles (the first lights of the set)
   std::vector<float> base_;       // per cell: the power choice
   enum class State : uint8_t { Undecided, Default, Learned };
   std::vector<State> state_;      // per region: Learned samples from its table, the others as EmitterSet
