@@ -157,6 +157,11 @@ void RenderOptions::addCommonTo(CLI::App& command) {
             "--guide-prior", [this](const std::string& v) { guide.vplPrior = v == "vpl"; },
             "--guide-learning on: what the guide starts from: vpl | none (uniform: learned only)")
       ->check(CLI::IsMember({"vpl", "none"}));
+  command.add_option_function<std::string>(
+            "--guide-interpolation", [this](const std::string& v) { guide.bilinear = v == "bilinear"; },
+            "guided modes: bilinear (default): the guide's density interpolated between its cells' corners | box: "
+            "constant over each cell (the paper's table)")
+      ->check(CLI::IsMember({"bilinear", "box"}));
   command.add_option("--mis-guide", misGuide,
                      "mis: where guide directions come from: exact (samples of the guide from the BSDF's stratified "
                      "number) | chain (the cache point's Metropolis chain, as the paper)")

@@ -50,7 +50,7 @@ GuideField buildGuideField(const RenderScene& scene, const VplField& field, cons
       // A cluster seen under a wide angle (near, or large) spreads over the angle it subtends.
       reps.push_back({arrival->direction, weight, std::atan2(settings.spreadScale * c.spread, arrival->distance)});
     }
-    cp.distribution = GuideDistribution(std::move(reps), settings.coneAngle, settings.defensive);
+    cp.distribution = GuideDistribution(std::move(reps), settings.coneAngle, settings.defensive, settings.bilinear);
   });
   GuideField guide(std::move(points), settings);
   std::vector<int32_t> perPixel(field.gather.pixelGather.size(), -1);

@@ -83,7 +83,7 @@ void GuideDistribution::coneCellsLinear(const glm::vec3& d, float cosCone, std::
 }
 
 GuideDistribution::GuideDistribution(const std::vector<GuideRepresentative>& representatives, float coneAngle,
-                                     float defensive)
+                                     float defensive, bool bilinear)
     : defensive_(defensive), representativeCount_(representatives.size()) {
   const float chord2Default = chord2FromAngle(coneAngle);
   std::vector<float> mass(kCells, 0.0f);
@@ -99,26 +99,94 @@ GuideDistribution::GuideDistribution(const std::vector<GuideRepresentative>& rep
     for (uint32_t c : cells) mass[c] += share;
     total_ += r.weight;
   }
-  choice_ = Distribution1D(mass);
+  if (bilinear) interpolateFromCorners(mass);
+  normalise(mass);
   if (choice_.empty()) total_ = 0.0;
-  cellDensity_ = float((1.0 - defensive_) / kCellSolidAngle);
 }
 
-GuideDistribution::GuideDistribution(std::span<const float> cellWeights, float defensive)
-    : choice_(cellWeights), total_(choice_.total()), defensive_(defensive) {
+GuideDistribution::GuideDistribution(std::span<const float> cellWeights, float defensive, bool bilinear)
+    : defensive_(defensive) {
+  if (bilinear) {
+    std::vector<float> mass(cellWeights.begin(), cellWeights.end());
+    interpolateFromCorners(mass);
+    normalise(mass);
+  } else {
+    normalise(cellWeights);
+  }
+  total_ = choice_.total();
+}
+
+void GuideDistribution::normalise(std::span<const float> cellWeights) {
+  choice_ = Distribution1D(cellWeights);
   cellDensity_ = float((1.0 - defensive_) / kCellSolidAngle);
+  if (choice_.empty()) corners_.clear();
+  for (float& v : corners_) v = float(v / choice_.total());
+}
+
+namespace {
+// A point of [0, 1] with density proportional to (1 - x) a + x b (a, b >= 0).
+float sampleLinear(float u, float a, float b) {
+  if (!(a + b > 0.0f) || a == b) return u;
+  const float x = u * (a + b) / (a + std::sqrt((1.0f - u) * a * a + u * b * b));
+  return std::min(x, 0x1.fffffep-1f);
+}
+}  // namespace
+
+void GuideDistribution::interpolateFromCorners(std::vector<float>& cellWeights) {
+  constexpr int r = kResolution, n = kResolution + 1;
+  corners_.assign(size_t(n * n), 0.0f);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      float sum = 0.0f;
+      int count = 0;
+      for (int dj = -1; dj <= 0; ++dj)
+        for (int di = -1; di <= 0; ++di) {
+          const int x = i + di, y = j + dj;
+          if (x < 0 || y < 0 || x >= r || y >= r) continue;
+          const float w = cellWeights[size_t(y * r + x)];
+          sum += std::isfinite(w) && w > 0.0f ? w : 0.0f;
+          ++count;
+        }
+      corners_[size_t(j * n + i)] = sum / float(count);
+    }
+  for (int y = 0; y < r; ++y)
+    for (int x = 0; x < r; ++x)
+      cellWeights[size_t(y * r + x)] = 0.25f * (corners_[size_t(y * n + x)] + corners_[size_t(y * n + x + 1)] +
+                                                corners_[size_t((y + 1) * n + x)] + corners_[size_t((y + 1) * n + x + 1)]);
+}
+
+float GuideDistribution::interpolatedShare(const glm::vec3& w) const {
+  constexpr int r = kResolution, n = kResolution + 1;
+  const glm::vec2 p = equalAreaSphereToSquare(w) * float(r);
+  const int ix = std::min(int(p.x), r - 1), iy = std::min(int(p.y), r - 1);
+  const float fx = std::clamp(p.x - float(ix), 0.0f, 1.0f), fy = std::clamp(p.y - float(iy), 0.0f, 1.0f);
+  const float* row0 = &corners_[size_t(iy * n + ix)];
+  const float* row1 = row0 + n;
+  return (1.0f - fy) * ((1.0f - fx) * row0[0] + fx * row0[1]) + fy * ((1.0f - fx) * row1[0] + fx * row1[1]);
+}
+
+glm::vec2 GuideDistribution::warpInCell(int cell, glm::vec2 u) const {
+  if (corners_.empty()) return u;
+  constexpr int r = kResolution, n = kResolution + 1;
+  const float* row0 = &corners_[size_t((cell / r) * n + cell % r)];
+  const float* row1 = row0 + n;
+  const float x = sampleLinear(u.x, row0[0] + row1[0], row0[1] + row1[1]);
+  const float y = sampleLinear(u.y, (1.0f - x) * row0[0] + x * row0[1], (1.0f - x) * row1[0] + x * row1[1]);
+  return {x, y};
 }
 
 float GuideDistribution::pdf(const glm::vec3& w) const {
   if (choice_.empty()) return uniformSpherePdf();
-  return cellDensity_ * choice_.pmf(size_t(cellOf(w))) + defensive_ * uniformSpherePdf();
+  const float share = corners_.empty() ? choice_.pmf(size_t(cellOf(w))) : interpolatedShare(w);
+  return cellDensity_ * share + defensive_ * uniformSpherePdf();
 }
 
 glm::vec3 GuideDistribution::sample(float uCell, glm::vec2 uPoint) const {
   if (choice_.empty() || uCell < defensive_) return sampleUniformSphere(uPoint);
   // Reuse uCell: it picks the cell after the defensive branch.
   const float uPick = std::min((uCell - defensive_) / (1.0f - defensive_), 0x1.fffffep-1f);
-  return pointInCell(int(choice_.sample(uPick)), uPoint);
+  const int cell = int(choice_.sample(uPick));
+  return pointInCell(cell, warpInCell(cell, uPoint));
 }
 
 glm::vec3 GuideDistribution::sample(glm::vec2 u) const {
@@ -140,7 +208,7 @@ glm::vec3 GuideDistribution::sample(glm::vec2 u) const {
   const float uInRow = float(std::clamp((y - rowStart) / rowMass, 0.0, double(0x1.fffffep-1f)));
   float uInCell = 0.0f;
   const int cell = int(choice_.sampleRange(ux, row * n, (row + 1) * n, &uInCell));
-  return pointInCell(cell, {uInCell, uInRow});
+  return pointInCell(cell, warpInCell(cell, {uInCell, uInRow}));
 }
 
 glm::vec3 GuideDistribution::pointInCell(int cell, glm::vec2 u) {
@@ -151,7 +219,7 @@ glm::vec3 GuideDistribution::pointInCell(int cell, glm::vec2 u) {
 }
 
 size_t GuideDistribution::memoryBytes() const {
-  return sizeof(*this) + choice_.size() * (sizeof(double) + sizeof(float));
+  return sizeof(*this) + choice_.size() * (sizeof(double) + sizeof(float)) + corners_.size() * sizeof(float);
 }
 
 }  // namespace vpl

@@ -8,6 +8,12 @@
 // equal-area square. Its sphere integral is exactly Z = sum of weights, and
 //   pdf(w) = (1 - eps) f(w) / Z + eps / (4 pi)        (uniform when Z = 0)
 // costs one table read; sampling picks a cell by its mass, then a uniform point in it.
+// Bilinear (the default): f is instead interpolated over the square from values at the cells'
+// corners (each the mean of the cells around it), so it no longer jumps at every cell edge; a
+// cell's mass is the mean of its corners, and a sample picks a cell by it, then warps the point in
+// the cell to the bilinear density (two linear inversions). f cos / pdf then varies smoothly, which
+// stratified numbers integrate better: per sample at 64 spp, relMSE 0.93x for `mixture` on the
+// Cornell box and 0.95x for `mis` on cornell_glossy.
 #pragma once
 #include <cstdint>
 #include <span>
@@ -27,18 +33,21 @@ struct GuideRepresentative {
 class GuideDistribution {
  public:
   // Cells per side of the equal-area map: 1024 cells of 0.0123 sr (about 6 degrees across), fine
-  // against the default 20-degree cone and 12 KiB per cache point.
+  // against the default 20-degree cone and 12 KiB per cache point (16 KiB with the corners).
   static constexpr int kResolution = 32;
   static constexpr int kCells = kResolution * kResolution;
   static constexpr double kCellSolidAngle = 4.0 * 3.14159265358979323846 / kCells;
 
   GuideDistribution() = default;
-  GuideDistribution(const std::vector<GuideRepresentative>& representatives, float coneAngle, float defensive);
+  GuideDistribution(const std::vector<GuideRepresentative>& representatives, float coneAngle, float defensive,
+                    bool bilinear = true);
   // A table given cell by cell (kCells weights >= 0), as the learner blends it; Z is their sum.
-  GuideDistribution(std::span<const float> cellWeights, float defensive);
+  GuideDistribution(std::span<const float> cellWeights, float defensive, bool bilinear = true);
 
-  // f(w): weight per steradian of w's cell.
-  float target(const glm::vec3& w) const { return float(choice_.pmf(size_t(cellOf(w))) * total_ / kCellSolidAngle); }
+  // f(w): weight per steradian around w (of w's cell, or interpolated).
+  float target(const glm::vec3& w) const {
+    return float((corners_.empty() ? choice_.pmf(size_t(cellOf(w))) : interpolatedShare(w)) * total_ / kCellSolidAngle);
+  }
   // Density of sample() per solid angle (includes the defensive term).
   float pdf(const glm::vec3& w) const;
   // uCell picks the defensive share or a cell, uPoint the point in the cell.
@@ -71,7 +80,18 @@ class GuideDistribution {
   size_t memoryBytes() const;
 
  private:
+  // Bilinear: makes the corner values from the cells' weights, and replaces each weight by the
+  // mean of its corners (the cell's integral of the interpolated density).
+  void interpolateFromCorners(std::vector<float>& cellWeights);
+  // Then: the table's share per cell, interpolated at w ...
+  float interpolatedShare(const glm::vec3& w) const;
+  // ... and a point in [0,1)^2 of the cell, distributed by it, from a uniform u.
+  glm::vec2 warpInCell(int cell, glm::vec2 u) const;
+  // Makes choice_ from the weights and expresses the corners in its units.
+  void normalise(std::span<const float> cellWeights);
+
   Distribution1D choice_;  // cells by their share of the weight (empty when Z = 0)
+  std::vector<float> corners_;  // bilinear: (kResolution + 1)^2 values, in units of a cell's share; else empty
   double total_ = 0.0;
   float cellDensity_ = 0.0f;  // (1 - eps) / cell solid angle: pdf = cellDensity_ pmf(cell) + eps / (4 pi)
   float defensive_ = 0.01f;

@@ -28,7 +28,7 @@ GuideLearner::GuideLearner(const GuideField& field, int tiles, bool vplPrior)
   current_.reserve(field.size());
   for (size_t c = 0; c < field.size(); ++c)
     current_.push_back(vplPrior ? field.point(int(c)).distribution
-                                : GuideDistribution(std::vector<GuideRepresentative>{}, 1.0f, field.settings().defensive));
+                                : GuideDistribution(std::vector<GuideRepresentative>{}, 1.0f, field.settings().defensive, field.settings().bilinear));
 }
 
 GuideDistribution GuideLearner::blend(int c) const {
@@ -55,7 +55,7 @@ GuideDistribution GuideLearner::blend(int c) const {
                                                      : 1.0 / kFineCells;
     weights[size_t(f)] = float((1.0 - lambda) * priorShare + lambda * sums[b] / learnedTotal * withinBlock);
   }
-  return GuideDistribution(weights, field_.settings().defensive);
+  return GuideDistribution(weights, field_.settings().defensive, field_.settings().bilinear);
 }
 
 void GuideLearner::update() {

@@ -19,6 +19,8 @@
 //                                    cornell_glossy, for about 1 % more rays per sample and 1 % of the time
 //   vplPrior           bool   true   learnDirections: start from the VPL guide; false: from a uniform one (a
 //                                    learned-only baseline, --guide-prior none)
+//   bilinear           bool   true   the guide's density interpolated between the cells' corners (false: constant
+//                                    over each cell, as the paper's table; guide_distribution.h has the figures)
 //   misChain           bool   false  mis: guide directions from the cache point's Markov chain (the paper); false:
 //                                    exact samples of the guide from the BSDF's own stratified number
 //   lookupCosNormal    float  0.9    a vertex uses a cache point only if their normals agree this well
@@ -46,6 +48,7 @@ struct GuideSettings {
   bool learnSelection = true;
   bool learnDirections = true;
   bool vplPrior = true;
+  bool bilinear = true;
   bool misChain = false;
   float lookupCosNormal = 0.9f;
   float lookupRadiusScale = 1.5f;

@@ -4,9 +4,11 @@
 #include <cstdio>
 #include <iterator>
 #include <numbers>
+#include <string>
 #include "render/guide/guide_distribution.h"
 #include "render/guide/guide_field.h"
 #include "render/guide/metropolis_sampler.h"
+#include "render/sampling/equal_area_map.h"
 #include "render/sampling/warps.h"
 #include "tests/unit/support.h"
 
@@ -40,31 +42,70 @@ std::vector<Case> cases() {
           {"near clusters", 20, 3, true, 90.0f}};
 }
 
-GuideDistribution makeDistribution(const Case& c, uint64_t seed) {
+GuideDistribution makeDistribution(const Case& c, uint64_t seed, bool bilinear = true) {
   std::vector<GuideRepresentative> reps = randomReps(c.reps, seed, c.clustered);
   Rng rng(seed ^ 0xc0e5ull);
   for (GuideRepresentative& r : reps) r.coneAngle = rng.uniform() * c.widestRepDegrees * kDeg;
-  return GuideDistribution(reps, c.coneDegrees * kDeg, 0.01f);
+  return GuideDistribution(reps, c.coneDegrees * kDeg, 0.01f, bilinear);
+}
+
+// Every case in both forms of the density: constant over each cell, and bilinear between corners.
+struct Form {
+  const Case& c;
+  bool bilinear;
+  std::string name() const { return std::string(c.name) + (bilinear ? ", bilinear" : ", box"); }
+};
+template <class Test>
+void forEachForm(Test&& test) {
+  for (const Case& c : cases())
+    for (bool bilinear : {false, true}) test(Form{c, bilinear});
 }
 
 TEST(GuideDistribution, PdfIntegratesToOneAndMatchesTheTarget) {
-  for (const Case& c : cases()) {
-    const GuideDistribution d = makeDistribution(c, 1);
+  forEachForm([](const Form& form) {
+    const Case& c = form.c;
+    const GuideDistribution d = makeDistribution(c, 1, form.bilinear);
     const double integral = test::integrateSphere([&](const glm::vec3& w) { return double(d.pdf(w)); }, 1024, 2048);
-    EXPECT_NEAR(integral, 1.0, c.coneDegrees < 10 ? 0.03 : 0.005) << c.name;
+    EXPECT_NEAR(integral, 1.0, c.coneDegrees < 10 ? 0.03 : 0.005) << form.name();
     Rng rng(2);
     for (int i = 0; i < 200; ++i) {
       const glm::vec3 w = sampleUniformSphere(rng.uniform2());
       const double expected = 0.99 * d.target(w) / d.totalWeight() + 0.01 / (4.0 * std::numbers::pi);
-      ASSERT_NEAR(d.pdf(w), expected, 1e-5 * expected) << c.name;
+      ASSERT_NEAR(d.pdf(w), expected, 1e-5 * expected) << form.name();
     }
-  }
+  });
 }
 
 TEST(GuideDistribution, TargetIntegratesToTotalWeight) {
-  const GuideDistribution d(randomReps(20, 3, true), 20.0f * kDeg, 0.01f);
-  const double integral = test::integrateSphere([&](const glm::vec3& w) { return double(d.target(w)); }, 1024, 2048);
-  EXPECT_NEAR(integral, d.totalWeight(), 0.005 * d.totalWeight());
+  for (bool bilinear : {false, true}) {
+    const GuideDistribution d(randomReps(20, 3, true), 20.0f * kDeg, 0.01f, bilinear);
+    const double integral = test::integrateSphere([&](const glm::vec3& w) { return double(d.target(w)); }, 1024, 2048);
+    EXPECT_NEAR(integral, d.totalWeight(), 0.005 * d.totalWeight()) << bilinear;
+  }
+}
+
+// The bilinear density is continuous across the edges between cells (within the square: its own
+// edges fold onto each other), where the box density jumps. Two points 2e-4 of the square's side
+// apart differ by at most 2e-4 x 32 = 0.64 % of the largest corner value when it is continuous.
+TEST(GuideDistribution, BilinearDensityIsContinuousAcrossCellEdges) {
+  const GuideDistribution smooth = makeDistribution(cases()[2], 4, true), box = makeDistribution(cases()[2], 4, false);
+  constexpr int r = GuideDistribution::kResolution;
+  constexpr float kStep = 1e-4f;
+  Rng rng(8);
+  double smoothJump = 0.0, boxJump = 0.0, smoothMax = 0.0, boxMax = 0.0;
+  for (int i = 0; i < 20000; ++i) {
+    // A point on a vertical edge between two cells, and one on either side of it.
+    const float x = float(1 + int(rng.below(r - 1))) / float(r), y = 0.02f + 0.96f * rng.uniform();
+    const glm::vec3 left = equalAreaSquareToSphere({x - kStep, y}), right = equalAreaSquareToSphere({x + kStep, y});
+    smoothJump = std::max(smoothJump, double(std::abs(smooth.pdf(left) - smooth.pdf(right))));
+    boxJump = std::max(boxJump, double(std::abs(box.pdf(left) - box.pdf(right))));
+    smoothMax = std::max({smoothMax, double(smooth.pdf(left)), double(smooth.pdf(right))});
+    boxMax = std::max({boxMax, double(box.pdf(left)), double(box.pdf(right))});
+  }
+  std::printf("largest jump of the pdf across a cell edge over its largest value: bilinear %.4f, box %.4f\n",
+              smoothJump / smoothMax, boxJump / boxMax);
+  EXPECT_LT(smoothJump, 0.0065 * smoothMax);
+  EXPECT_GT(boxJump, 0.1 * boxMax) << "the test cannot see a jump";
 }
 
 TEST(GuideDistribution, KdTreeConeQueryEqualsLinearScan) {
@@ -93,7 +134,7 @@ TEST(GuideDistribution, KdTreeConeQueryEqualsLinearScan) {
 TEST(GuideDistribution, TargetIsTheConeAverageAtCellCentres) {
   // One representative: its weight spread over the cells whose centres see it within the cone.
   const glm::vec3 dir = glm::normalize(glm::vec3(0.2f, -0.5f, 0.7f));
-  const GuideDistribution d({{dir, 3.0f}}, 20.0f * kDeg, 0.01f);
+  const GuideDistribution d({{dir, 3.0f}}, 20.0f * kDeg, 0.01f, false);
   std::vector<uint32_t> cells;
   GuideDistribution::coneCellsLinear(dir, std::cos(20.0f * kDeg), cells);
   ASSERT_GT(cells.size(), 10u);
@@ -104,7 +145,7 @@ TEST(GuideDistribution, TargetIsTheConeAverageAtCellCentres) {
   for (uint32_t c : cells) ASSERT_NEAR(d.target(GuideDistribution::cellCentre(int(c))), expected, 1e-5 * expected);
   EXPECT_EQ(d.target(-dir), 0.0f);
   // A representative asking for a wider cone spreads the same weight over more cells.
-  const GuideDistribution wide({{dir, 3.0f, 60.0f * kDeg}}, 20.0f * kDeg, 0.01f);
+  const GuideDistribution wide({{dir, 3.0f, 60.0f * kDeg}}, 20.0f * kDeg, 0.01f, false);
   cells.clear();
   GuideDistribution::coneCellsLinear(dir, std::cos(60.0f * kDeg), cells);
   const double wideExpected = 3.0 / (double(cells.size()) * GuideDistribution::kCellSolidAngle);
@@ -122,25 +163,25 @@ TEST(GuideDistribution, ZeroWeightIsUniform) {
 }
 
 TEST(GuideDistribution, ExactSamplerMatchesPdf) {
-  for (const Case& c : cases()) {
-    const GuideDistribution d = makeDistribution(c, 6);
+  forEachForm([](const Form& form) {
+    const GuideDistribution d = makeDistribution(form.c, 6, form.bilinear);
     Rng rng(7);
     const auto r = test::chiSquareEqualArea([&] { return d.sample(rng); }, [&](const glm::vec3& w) { return double(d.pdf(w)); },
                                             200000, 2 * GuideDistribution::kResolution);
-    EXPECT_GT(r.pValue, 1e-4) << c.name << ": " << r.report;
-  }
+    EXPECT_GT(r.pValue, 1e-4) << form.name() << ": " << r.report;
+  });
 }
 
 // The one-number form that mis uses (the BSDF's 2D number, rescaled): same density.
 TEST(GuideDistribution, SamplerFromOne2DNumberMatchesPdf) {
-  for (const Case& c : cases()) {
-    const GuideDistribution d = makeDistribution(c, 6);
+  forEachForm([](const Form& form) {
+    const GuideDistribution d = makeDistribution(form.c, 6, form.bilinear);
     Rng rng(17);
     const auto r = test::chiSquareEqualArea([&] { return d.sample(rng.uniform2()); },
                                             [&](const glm::vec3& w) { return double(d.pdf(w)); }, 200000,
                                             2 * GuideDistribution::kResolution);
-    EXPECT_GT(r.pValue, 1e-4) << c.name << ": " << r.report;
-  }
+    EXPECT_GT(r.pValue, 1e-4) << form.name() << ": " << r.report;
+  });
 }
 
 // ... and stratified numbers stay stratified: the count of directions above the equator from a
