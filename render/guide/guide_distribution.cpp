@@ -1,5 +1,6 @@
 #include "render/guide/guide_distribution.h"
 
+#include <array>
 #include <cmath>
 #include <nanoflann.hpp>
 #include "render/sampling/equal_area_map.h"
@@ -206,9 +207,45 @@ glm::vec3 GuideDistribution::sample(glm::vec2 u) const {
   while (!(choice_.cdf((row + 1) * n) > choice_.cdf(row * n)) && row > 0) --row;  // rounding at the top
   const double rowStart = choice_.cdf(row * n), rowMass = choice_.cdf((row + 1) * n) - rowStart;
   const float uInRow = float(std::clamp((y - rowStart) / rowMass, 0.0, double(0x1.fffffep-1f)));
+  if (!corners_.empty())
+    if (const auto p = sampleAlongRow(int(row), uInRow, ux)) return equalAreaSquareToSphere(*p);
   float uInCell = 0.0f;
   const int cell = int(choice_.sampleRange(ux, row * n, (row + 1) * n, &uInCell));
   return pointInCell(cell, warpInCell(cell, {uInCell, uInRow}));
+}
+
+std::optional<glm::vec2> GuideDistribution::sampleAlongRow(int row, float uInRow, float ux) const {
+  constexpr int r = kResolution, n = kResolution + 1;
+  const float* below = &corners_[size_t(row * n)];
+  const float* above = below + n;
+  float lineBelow = 0.0f, lineAbove = 0.0f;  // twice the density integrated along each line
+  for (int i = 0; i < r; ++i) {
+    lineBelow += below[i] + below[i + 1];
+    lineAbove += above[i] + above[i + 1];
+  }
+  const float t = sampleLinear(uInRow, lineBelow, lineAbove);
+  std::array<float, n> along;  // the density along height t, at the corners' columns
+  for (int i = 0; i < n; ++i) along[size_t(i)] = (1.0f - t) * below[i] + t * above[i];
+  float total = 0.0f;
+  for (int i = 0; i < r; ++i) total += along[size_t(i)] + along[size_t(i) + 1];
+  if (!(total > 0.0f)) return std::nullopt;
+  // The cell whose share of the line holds ux; the last one with any, if rounding runs past the end.
+  const float target = ux * total;
+  int cell = -1;
+  float before = 0.0f, beforeCell = 0.0f;
+  for (int i = 0; i < r; ++i) {
+    const float mass = along[size_t(i)] + along[size_t(i) + 1];
+    if (!(mass > 0.0f)) continue;
+    cell = i;
+    beforeCell = before;
+    if (before + mass > target) break;
+    before += mass;
+  }
+  if (cell < 0) return std::nullopt;
+  const float a = along[size_t(cell)], b = along[size_t(cell) + 1];
+  const float uInCell = std::clamp((target - beforeCell) / (a + b), 0.0f, 0x1.fffffep-1f);
+  constexpr float kInside = 0x1.fffffep-1f;
+  return glm::vec2((float(cell) + sampleLinear(uInCell, a, b) * kInside) / float(r), (float(row) + t * kInside) / float(r));
 }
 
 glm::vec3 GuideDistribution::pointInCell(int cell, glm::vec2 u) {

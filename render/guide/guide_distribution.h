@@ -16,6 +16,7 @@
 // Cornell box and 0.95x for `mis` on cornell_glossy.
 #pragma once
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 #include <glm/glm.hpp>
@@ -87,6 +88,10 @@ class GuideDistribution {
   float interpolatedShare(const glm::vec3& w) const;
   // ... and a point in [0,1)^2 of the cell, distributed by it, from a uniform u.
   glm::vec2 warpInCell(int cell, glm::vec2 u) const;
+  // sample(u)'s inversion within a row, continuous across rows too: the height in the row follows
+  // the density integrated across it, then the cell and the point follow the density along that
+  // height. A point of the square, or nothing where rounding left the height without density.
+  std::optional<glm::vec2> sampleAlongRow(int row, float uInRow, float ux) const;
   // Makes choice_ from the weights and expresses the corners in its units.
   void normalise(std::span<const float> cellWeights);
 
