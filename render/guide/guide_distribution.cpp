@@ -151,9 +151,10 @@ void GuideDistribution::interpolateFromCorners(std::vector<float>& cellWeights) 
       corners_[size_t(j * n + i)] = sum / float(count);
     }
   for (int y = 0; y < r; ++y)
-    for (int x = 0; x < r; ++x)
-      cellWeights[size_t(y * r + x)] = 0.25f * (corners_[size_t(y * n + x)] + corners_[size_t(y * n + x + 1)] +
-                                                corners_[size_t((y + 1) * n + x)] + corners_[size_t((y + 1) * n + x + 1)]);
+    for (int x = 0; x < r; ++x) {
+      const float* below = &corners_[size_t(y * n + x)];
+      cellWeights[size_t(y * r + x)] = 0.25f * (below[0] + below[1] + below[n] + below[n + 1]);
+    }
 }
 
 float GuideDistribution::interpolatedShare(const glm::vec3& w) const {
@@ -245,7 +246,8 @@ std::optional<glm::vec2> GuideDistribution::sampleAlongRow(int row, float uInRow
   const float a = along[size_t(cell)], b = along[size_t(cell) + 1];
   const float uInCell = std::clamp((target - beforeCell) / (a + b), 0.0f, 0x1.fffffep-1f);
   constexpr float kInside = 0x1.fffffep-1f;
-  return glm::vec2((float(cell) + sampleLinear(uInCell, a, b) * kInside) / float(r), (float(row) + t * kInside) / float(r));
+  const float x = sampleLinear(uInCell, a, b);
+  return glm::vec2((float(cell) + x * kInside) / float(r), (float(row) + t * kInside) / float(r));
 }
 
 glm::vec3 GuideDistribution::pointInCell(int cell, glm::vec2 u) {

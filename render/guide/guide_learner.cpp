@@ -26,9 +26,10 @@ void GuideLearner::TileLog::add(int cachePoint, const glm::vec3& wi, float value
 GuideLearner::GuideLearner(const GuideField& field, int tiles, bool vplPrior)
     : field_(field), vplPrior_(vplPrior), sums_(field.size()), samples_(field.size(), 0), tiles_(size_t(tiles)) {
   current_.reserve(field.size());
+  const GuideSettings& s = field.settings();
   for (size_t c = 0; c < field.size(); ++c)
     current_.push_back(vplPrior ? field.point(int(c)).distribution
-                                : GuideDistribution(std::vector<GuideRepresentative>{}, 1.0f, field.settings().defensive, field.settings().bilinear));
+                                : GuideDistribution(std::vector<GuideRepresentative>{}, 1.0f, s.defensive, s.bilinear));
 }
 
 GuideDistribution GuideLearner::blend(int c) const {
@@ -55,6 +56,8 @@ GuideDistribution GuideLearner::blend(int c) const {
                                                      : 1.0 / kFineCells;
     weights[size_t(f)] = float((1.0 - lambda) * priorShare + lambda * sums[b] / learnedTotal * withinBlock);
   }
+  // Bilinear, the prior's shares are already the interpolated guide's, so the blend is interpolated
+  // once more: the prior's part a cell wider, against learned blocks four cells wide.
   return GuideDistribution(weights, field_.settings().defensive, field_.settings().bilinear);
 }
 
