@@ -170,7 +170,8 @@ std::optional<LightSample> EmitterGuide::sampleLearned(const glm::vec3& p, uint3
     return s;
   }
   if (cell >= uint32_t(punctualFirst_)) {
-    auto s = scene_->emitters().samplePunctual(p, scene_->emitters().triangleCount() + (cell - uint32_t(punctualFirst_)), width);
+    const EmitterSet& emitters = scene_->emitters();
+    auto s = emitters.samplePunctual(p, emitters.triangleCount() + (cell - uint32_t(punctualFirst_)), width);
     if (s) s->guideSlot = slot;
     return s;
   }

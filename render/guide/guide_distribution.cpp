@@ -100,25 +100,20 @@ GuideDistribution::GuideDistribution(const std::vector<GuideRepresentative>& rep
     for (uint32_t c : cells) mass[c] += share;
     total_ += r.weight;
   }
-  if (bilinear) interpolateFromCorners(mass);
-  normalise(mass);
+  setTable(mass, bilinear);
   if (choice_.empty()) total_ = 0.0;
 }
 
 GuideDistribution::GuideDistribution(std::span<const float> cellWeights, float defensive, bool bilinear)
     : defensive_(defensive) {
-  if (bilinear) {
-    std::vector<float> mass(cellWeights.begin(), cellWeights.end());
-    interpolateFromCorners(mass);
-    normalise(mass);
-  } else {
-    normalise(cellWeights);
-  }
+  std::vector<float> mass(cellWeights.begin(), cellWeights.end());
+  setTable(mass, bilinear);
   total_ = choice_.total();
 }
 
-void GuideDistribution::normalise(std::span<const float> cellWeights) {
-  choice_ = Distribution1D(cellWeights);
+void GuideDistribution::setTable(std::vector<float>& mass, bool bilinear) {
+  if (bilinear) interpolateFromCorners(mass);
+  choice_ = Distribution1D(mass);
   cellDensity_ = float((1.0 - defensive_) / kCellSolidAngle);
   if (choice_.empty()) corners_.clear();
   for (float& v : corners_) v = float(v / choice_.total());
@@ -152,7 +147,7 @@ void GuideDistribution::interpolateFromCorners(std::vector<float>& cellWeights) 
     }
   for (int y = 0; y < r; ++y)
     for (int x = 0; x < r; ++x) {
-      const float* below = &corners_[size_t(y * n + x)];
+      const float* below = cornersBelow(x, y);
       cellWeights[size_t(y * r + x)] = 0.25f * (below[0] + below[1] + below[n] + below[n + 1]);
     }
 }
@@ -162,15 +157,15 @@ float GuideDistribution::interpolatedShare(const glm::vec3& w) const {
   const glm::vec2 p = equalAreaSphereToSquare(w) * float(r);
   const int ix = std::min(int(p.x), r - 1), iy = std::min(int(p.y), r - 1);
   const float fx = std::clamp(p.x - float(ix), 0.0f, 1.0f), fy = std::clamp(p.y - float(iy), 0.0f, 1.0f);
-  const float* row0 = &corners_[size_t(iy * n + ix)];
+  const float* row0 = cornersBelow(ix, iy);
   const float* row1 = row0 + n;
   return (1.0f - fy) * ((1.0f - fx) * row0[0] + fx * row0[1]) + fy * ((1.0f - fx) * row1[0] + fx * row1[1]);
 }
 
 glm::vec2 GuideDistribution::warpInCell(int cell, glm::vec2 u) const {
   if (corners_.empty()) return u;
-  constexpr int r = kResolution, n = kResolution + 1;
-  const float* row0 = &corners_[size_t((cell / r) * n + cell % r)];
+  constexpr int n = kResolution + 1;
+  const float* row0 = cornersBelow(cell % kResolution, cell / kResolution);
   const float* row1 = row0 + n;
   const float x = sampleLinear(u.x, row0[0] + row1[0], row0[1] + row1[1]);
   const float y = sampleLinear(u.y, (1.0f - x) * row0[0] + x * row0[1], (1.0f - x) * row1[0] + x * row1[1]);
@@ -217,7 +212,7 @@ glm::vec3 GuideDistribution::sample(glm::vec2 u) const {
 
 std::optional<glm::vec2> GuideDistribution::sampleAlongRow(int row, float uInRow, float ux) const {
   constexpr int r = kResolution, n = kResolution + 1;
-  const float* below = &corners_[size_t(row * n)];
+  const float* below = cornersBelow(0, row);
   const float* above = below + n;
   float lineBelow = 0.0f, lineAbove = 0.0f;  // twice the density integrated along each line
   for (int i = 0; i < r; ++i) {

@@ -92,8 +92,10 @@ class GuideDistribution {
   // the density integrated across it, then the cell and the point follow the density along that
   // height. A point of the square, or nothing where rounding left the height without density.
   std::optional<glm::vec2> sampleAlongRow(int row, float uInRow, float ux) const;
-  // Makes choice_ from the weights and expresses the corners in its units.
-  void normalise(std::span<const float> cellWeights);
+  // Makes the table from the cells' weights: choice_ (and, bilinear, the corners in its units).
+  void setTable(std::vector<float>& mass, bool bilinear);
+  // The corners of cell (x, y): [0] and [1] at its lower edge, [kResolution + 1] and the next at its upper.
+  const float* cornersBelow(int x, int y) const { return &corners_[size_t(y * (kResolution + 1) + x)]; }
 
   Distribution1D choice_;  // cells by their share of the weight (empty when Z = 0)
   std::vector<float> corners_;  // bilinear: (kResolution + 1)^2 values, in units of a cell's share; else empty
