@@ -3,12 +3,14 @@
 
   python3 make_scenes.py                  # the committed small scenes, into this folder
   python3 make_scenes.py --out DIR        # every scene, into DIR
-  python3 make_scenes.py --interior-only --out DIR   # the large interior and skylit hall (built by CMake)
+  python3 make_scenes.py --interior-only --out DIR   # the generated ones: interior, skylit hall, lamp rooms (CMake)
 
 Scenes: cornell_box (the viewer's default), cornell_glossy, two_rooms (light in one room, camera in
 the other), door_ajar (light only behind a door open 15 degrees, camera in the other room),
 interior.glb (a sun-lit hall of more than 100K triangles, a Sponza stand-in), skylit_hall.glb (the
-same hall, matte, lit through its skylights by an emitting panel: a large scene Cycles maps exactly).
+same hall, matte, lit through its skylights by an emitting panel: a large scene Cycles maps exactly),
+lamp_rooms.glb (six rooms in a row, each lit by its own tessellated globe lamp: 1920 emitting
+triangles, most of them hidden from any one point).
 Units are metres, +Y up. Punctual intensities: candela / lux; emission: nits (emissive strength).
 """
 import argparse
@@ -68,6 +70,33 @@ class Mesh:
             if inward:
                 q = q[::-1]
             self.quad(*q)
+
+    def sphere(self, centre, radius, subdivisions):
+        """An icosphere: the icosahedron's faces split in four `subdivisions` times, wound outwards."""
+        t = (1.0 + math.sqrt(5.0)) / 2.0
+        points = [norm(p) for p in ((-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0), (0, -1, t), (0, 1, t),
+                                    (0, -1, -t), (0, 1, -t), (t, 0, -1), (t, 0, 1), (-t, 0, -1), (-t, 0, 1))]
+        faces = [(0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11), (1, 5, 9), (5, 11, 4), (11, 10, 2),
+                 (10, 7, 6), (7, 1, 8), (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8), (3, 8, 9), (4, 9, 5),
+                 (2, 4, 11), (6, 2, 10), (8, 6, 7), (9, 8, 1)]
+        for _ in range(subdivisions):
+            midpoints, split = {}, []
+
+            def midpoint(a, b):
+                key = (min(a, b), max(a, b))
+                if key not in midpoints:
+                    points.append(norm(mul(add(points[a], points[b]), 0.5)))
+                    midpoints[key] = len(points) - 1
+                return midpoints[key]
+            for a, b, c in faces:
+                ab, bc, ca = midpoint(a, b), midpoint(b, c), midpoint(c, a)
+                split += [(a, ab, ca), (b, bc, ab), (c, ca, bc), (ab, bc, ca)]
+            faces = split
+        first = len(self.positions)
+        for n in points:
+            self.vertex(add(centre, mul(n, radius)), n)
+        for f in faces:
+            self.indices += [first + k for k in f]
 
     def slab(self, corner, a, b, c):
         """A parallelepiped from corner along edges a, b, c, each face wound to face outwards."""
@@ -434,6 +463,45 @@ def skylit_hall():
     return build_gltf(hall_meshes() + [panel], mats, HALL_CAMERA)
 
 
+LAMP_ROOMS = 6
+
+
+def lamp_rooms():
+    """Six rooms in a row along +X, each 4 x 4 m and 2.8 m high, joined by doorways that alternate
+    between the two sides (z = -1 and z = +1), so no line of sight runs through more than two of them.
+    Each room is lit by its own globe lamp (an icosphere of 320 triangles, 0.15 m in radius, hanging
+    at 2.2 m): 1920 emitting triangles, of which a point sees at most its own room's and, through a
+    doorway, a neighbour's. Sampling the lamps by power sends five of six shadow rays into walls; this
+    is the scene where learned light samples must group triangles (render/guide/emitter_guide.h).
+    The camera stands in the first room and looks through its doorway into the second. Materials map
+    exactly to Cycles: Lambertian, the lamps one-sided with a black base colour."""
+    mats = [material("white", (0.8, 0.8, 0.78), lambert=True), material("floor", (0.6, 0.45, 0.3), lambert=True),
+            material("blue", (0.2, 0.3, 0.7), lambert=True), material("terracotta", (0.7, 0.3, 0.2), lambert=True),
+            material("lamp", (0.0, 0.0, 0.0), emissive=(1.0, 0.9, 0.75), strength=20.0, lambert=True,
+                     double_sided=False)]
+    W, D, H, door_w, door_h = 4.0, 2.0, 2.8, 0.45, 2.1
+    X = W * LAMP_ROOMS
+    walls, floor, ends, furniture, lamps = Mesh("walls", 0), Mesh("floor", 1), Mesh("end_walls", 2), Mesh("furniture", 3), Mesh("lamps", 4)
+    floor.quad((0, 0, D), (X, 0, D), (X, 0, -D), (0, 0, -D))
+    walls.quad((0, H, -D), (X, H, -D), (X, H, D), (0, H, D))      # ceiling
+    walls.quad((0, 0, -D), (X, 0, -D), (X, H, -D), (0, H, -D))    # side z = -D
+    walls.quad((X, 0, D), (0, 0, D), (0, H, D), (X, H, D))        # side z = +D
+    ends.quad((0, 0, D), (0, 0, -D), (0, H, -D), (0, H, D))       # the first room's end
+    ends.quad((X, 0, -D), (X, 0, D), (X, H, D), (X, H, -D))       # the last room's end
+    for k in range(1, LAMP_ROOMS):
+        x, zc = W * k, (-1.0 if k % 2 else 1.0)                    # a two-sided wall with its doorway at zc
+        walls.quad((x, 0, -D), (x, 0, zc - door_w), (x, H, zc - door_w), (x, H, -D))
+        walls.quad((x, 0, zc + door_w), (x, 0, D), (x, H, D), (x, H, zc + door_w))
+        walls.quad((x, door_h, zc - door_w), (x, door_h, zc + door_w), (x, H, zc + door_w), (x, H, zc - door_w))
+    for k in range(LAMP_ROOMS):
+        x0 = W * k
+        lamps.sphere((x0 + W / 2, 2.2, 0.3 if k % 2 else -0.3), 0.15, 2)
+        furniture.box((x0 + 0.4, 0.0, 0.9 if k % 2 else -1.8), (x0 + 1.6, 0.8, 1.8 if k % 2 else -0.9), rotate=8.0 * (k % 3))
+        furniture.box((x0 + 2.6, 0.0, -1.8 if k % 2 else 1.2), (x0 + 3.3, 1.4, -1.2 if k % 2 else 1.8), rotate=-12.0)
+    return build_gltf([floor, walls, ends, furniture, lamps], mats,
+                      ((0.5, 1.5, 1.5), (4.0, 1.1, -0.9), math.radians(65.0)))
+
+
 def main():
     here = os.path.dirname(os.path.abspath(__file__))
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -450,6 +518,7 @@ def main():
     if args.interior_only or args.out:
         write_glb(os.path.join(out, "interior.glb"), interior())
         write_glb(os.path.join(out, "skylit_hall.glb"), skylit_hall())
+        write_glb(os.path.join(out, "lamp_rooms.glb"), lamp_rooms())
 
 
 if __name__ == "__main__":

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include "render/sampling/equal_area_map.h"
 #include "render/sampling/warps.h"
 
@@ -10,11 +11,20 @@ namespace vpl {
 EmitterGuide::EmitterGuide(const RenderScene& scene, bool enabled) {
   const EmitterSet& emitters = scene.emitters();
   const size_t triangles = emitters.triangleCount(), punctual = emitters.punctualCount();
-  if (!enabled || emitters.empty() || triangles > size_t(kMaxTriangles) || punctual > size_t(kMaxPunctual)) return;
-  // The finest square grid that keeps every triangle's cells within kMaxCells in all.
-  while (triangles > 0 && triangles * size_t(4 * grid_ * grid_) <= size_t(kMaxCells)) grid_ *= 2;
-  for (size_t t = 0; t < triangles; ++t)
-    for (int c = 0; c < grid_ * grid_; ++c) base_.push_back(emitters.emitterPmf(t) / float(grid_ * grid_));
+  if (!enabled || emitters.empty() || punctual > size_t(kMaxPunctual)) return;
+  if (triangles > size_t(kMaxCells)) {
+    groupTriangles(emitters);
+    for (size_t g = 0; g + 1 < groupFirst_.size(); ++g) {
+      float power = 0.0f;
+      for (uint32_t k = groupFirst_[g]; k < groupFirst_[g + 1]; ++k) power += emitters.emitterPmf(groupTriangles_[k]);
+      base_.push_back(power);
+    }
+  } else {
+    // The finest square grid that keeps every triangle's cells within kMaxCells in all.
+    while (triangles > 0 && triangles * size_t(4 * grid_ * grid_) <= size_t(kMaxCells)) grid_ *= 2;
+    for (size_t t = 0; t < triangles; ++t)
+      for (int c = 0; c < grid_ * grid_; ++c) base_.push_back(emitters.emitterPmf(t) / float(grid_ * grid_));
+  }
   punctualFirst_ = int(base_.size());
   for (size_t i = 0; i < punctual; ++i) base_.push_back(emitters.emitterPmf(triangles + i));
   skyFirst_ = int(base_.size());
@@ -48,6 +58,62 @@ EmitterGuide::EmitterGuide(const RenderScene& scene, bool enabled) {
   scene_ = &scene;
 }
 
+void EmitterGuide::groupTriangles(const EmitterSet& emitters) {
+  const size_t n = emitters.triangleCount();
+  std::vector<uint32_t> order(n);
+  std::iota(order.begin(), order.end(), 0u);
+  // Depth first, the lower half first, so that the groups come out as consecutive runs of `order`.
+  struct Range {
+    size_t first, last;
+    int groups;
+  };
+  std::vector<Range> pending{{0, n, kMaxCells}};
+  groupFirst_.clear();
+  while (!pending.empty()) {
+    const Range r = pending.back();
+    pending.pop_back();
+    if (r.groups == 1) {
+      groupFirst_.push_back(uint32_t(r.first));
+      continue;
+    }
+    glm::vec3 low(INFINITY), high(-INFINITY);
+    for (size_t k = r.first; k < r.last; ++k) {
+      low = glm::min(low, emitters.triangleCentroid(order[k]));
+      high = glm::max(high, emitters.triangleCentroid(order[k]));
+    }
+    const glm::vec3 extent = high - low;
+    const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
+    // Each side keeps as many triangles per group as the other (n > kMaxCells: at least one each).
+    const int lowerGroups = r.groups / 2;
+    const size_t middle = r.first + (r.last - r.first) * size_t(lowerGroups) / size_t(r.groups);
+    std::nth_element(order.begin() + std::ptrdiff_t(r.first), order.begin() + std::ptrdiff_t(middle),
+                     order.begin() + std::ptrdiff_t(r.last), [&](uint32_t a, uint32_t b) {
+                       const float ca = emitters.triangleCentroid(a)[axis], cb = emitters.triangleCentroid(b)[axis];
+                       return ca < cb || (ca == cb && a < b);
+                     });
+    pending.push_back({middle, r.last, r.groups - lowerGroups});
+    pending.push_back({r.first, middle, lowerGroups});
+  }
+  groupFirst_.push_back(uint32_t(n));
+  groupTriangles_ = std::move(order);
+  groupOf_.assign(n, 0);
+  areaShare_.assign(n, 0.0f);
+  groupCdf_.assign(n, 0.0f);
+  for (size_t g = 0; g + 1 < groupFirst_.size(); ++g) {
+    double area = 0.0;
+    for (uint32_t k = groupFirst_[g]; k < groupFirst_[g + 1]; ++k) area += double(emitters.triangleArea(groupTriangles_[k]));
+    double cumulative = 0.0;
+    for (uint32_t k = groupFirst_[g]; k < groupFirst_[g + 1]; ++k) {
+      const uint32_t t = groupTriangles_[k];
+      groupOf_[t] = uint32_t(g);
+      areaShare_[t] = float(double(emitters.triangleArea(t)) / area);
+      cumulative += double(emitters.triangleArea(t)) / area;
+      groupCdf_[k] = float(cumulative);
+    }
+    groupCdf_[groupFirst_[g + 1] - 1] = 1.0f;
+  }
+}
+
 std::atomic<uint64_t>* EmitterGuide::Lane::sumsOf(uint32_t region, size_t cells) {
   std::atomic<uint64_t>* block = sums[region].load(std::memory_order_acquire);
   if (block) return block;
@@ -78,7 +144,7 @@ uint32_t EmitterGuide::slotOf(uint32_t region, const LightSample& s, const glm::
   const size_t e = size_t(s.emitter);
   uint32_t cell;
   const size_t triangles = scene_->emitters().triangleCount();
-  if (e < triangles) cell = cellOf(e, scene_->emitters().squareOf(e, p + s.wi * s.distance));
+  if (e < triangles) cell = cellAt(e, p + s.wi * s.distance);
   else if (int(e) == scene_->emitters().skyIndex()) cell = uint32_t(skyFirst_ + equalAreaCell(s.wi, kSkyResolution));
   else cell = uint32_t(punctualFirst_) + uint32_t(e - triangles);
   return region * uint32_t(cells_) + cell;
@@ -175,6 +241,19 @@ std::optional<LightSample> EmitterGuide::sampleLearned(const glm::vec3& p, uint3
     if (s) s->guideSlot = slot;
     return s;
   }
+  if (grouped()) {
+    // A triangle of the group by its share of the group's area (x rescaled once more), then its point.
+    const uint32_t first = groupFirst_[cell], count = groupFirst_[cell + 1] - first;
+    const float* shares = groupCdf_.data() + first;
+    const uint32_t k = uint32_t(std::min(int(std::upper_bound(shares, shares + count, x) - shares), int(count) - 1));
+    const float before = k > 0 ? shares[k - 1] : 0.0f, share = shares[k] - before;
+    if (!(share > 0.0f)) return std::nullopt;
+    const size_t triangle = groupTriangles_[first + k];
+    const glm::vec2 square(std::clamp((x - before) / share, 0.0f, std::nextafter(1.0f, 0.0f)), u.y);
+    auto s = scene_->emitters().sampleTriangleByArea(p, triangle, square, width * areaShare_[triangle]);
+    if (s) s->guideSlot = slot;
+    return s;
+  }
   const size_t triangle = cell / uint32_t(grid_ * grid_);
   const uint32_t inTriangle = cell % uint32_t(grid_ * grid_);
   const glm::vec2 square = (glm::vec2(float(inTriangle % uint32_t(grid_)), float(inTriangle / uint32_t(grid_))) +
@@ -197,7 +276,7 @@ float EmitterGuide::pdf(const glm::vec3& p, const SurfaceHit& hit) const {
   if (state_[region] != State::Learned) return emitters.pdfTriangle(p, hit);
   const int32_t t = emitters.emitterOf(hit);
   if (t < 0) return 0.0f;
-  const float choice = triangleChoice(region, size_t(t), emitters.squareOf(size_t(t), hit.position));
+  const float choice = triangleChoice(region, size_t(t), cellAt(size_t(t), hit.position));
   return emitters.solidAnglePdfOfArea(p, size_t(t), hit.position, hit.geometricNormal, hit.frontFace, choice);
 }
 
@@ -216,7 +295,7 @@ float EmitterGuide::nextEventPdfTimesCos(const glm::vec3& p, const EmissionSampl
   if (!(dist2 > 0.0f)) return 0.0f;
   const bool front = glm::dot(e.normal, emitters.triangleNormal(e.emitter)) > 0.0f;
   const float solidAngle = emitters.solidAnglePdfOfArea(p, e.emitter, e.position, e.normal, front,
-                                                        triangleChoice(region, e.emitter, e.square));
+                                                        triangleChoice(region, e.emitter, cellOf(e.emitter, e.square)));
   return solidAngle * std::abs(glm::dot(e.normal, d)) / std::sqrt(dist2);
 }
 

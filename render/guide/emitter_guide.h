@@ -24,9 +24,12 @@
 // estimate stays unbiased whatever was learned; the records are integer sums, so the next pass's
 // tables do not depend on the thread count.
 //
-// Only for scenes of at most kMaxTriangles emitting triangles and kMaxPunctual punctual lights, and
-// with more than one cell to choose from (otherwise inactive: the caller keeps EmitterSet's own
-// sampling).
+// Up to kMaxCells emitting triangles each get a grid of cells. Beyond that (a tessellated lamp, a
+// lamp in every room) a cell is a group of nearby triangles instead (their centroids split at the
+// median of the longest axis, recursively, into kMaxCells groups), whose points a learned region
+// samples uniformly by area: a triangle by its share of the group's area, then its point.
+// Only for scenes of at most kMaxPunctual punctual lights and with more than one cell to choose from
+// (otherwise inactive: the caller keeps EmitterSet's own sampling).
 #pragma once
 #include <atomic>
 #include <cstdint>
@@ -48,7 +51,6 @@ class EmitterGuide {
   static constexpr float kArrivalShare = 0.5f;
   static constexpr uint64_t kMinAttempts = 256;
   static constexpr int kMaxCells = 128;        // per region: cells over all triangles
-  static constexpr int kMaxTriangles = kMaxCells;
   static constexpr int kMaxPunctual = 64;
   static constexpr int kSkyResolution = 16;
   static constexpr int kTargetRegions = 1024;  // the box is cut into about this many, near-cubic
@@ -125,27 +127,42 @@ class EmitterGuide {
   };
 
   uint32_t regionOf(const glm::vec3& p) const;
-  // Cell index of a point of triangle t at `square`.
+  bool grouped() const { return !groupOf_.empty(); }
+  // Cell index of a point of triangle t at `square` ...
   uint32_t cellOf(size_t triangle, glm::vec2 square) const {
+    if (grouped()) return groupOf_[triangle];
     const glm::ivec2 c = glm::min(glm::ivec2(square * float(grid_)), glm::ivec2(grid_ - 1));
     return uint32_t((int(triangle) * grid_ + c.y) * grid_ + c.x);
   }
+  // ... and at x (its square is needed only for a grid).
+  uint32_t cellAt(size_t triangle, const glm::vec3& x) const {
+    return grouped() ? groupOf_[triangle] : cellOf(triangle, scene_->emitters().squareOf(triangle, x));
+  }
+  // Splits the emitting triangles into kMaxCells groups of nearby ones (groupOf_ and the rest).
+  void groupTriangles(const EmitterSet& emitters);
   uint32_t slotOf(uint32_t region, const LightSample& s, const glm::vec3& p) const;
   // The probability that learned region r picks `cell`.
   float cellPmf(uint32_t region, uint32_t cell) const {
     const float* cdf = tables_[region]->cdf.data();
     return cdf[cell] - (cell > 0 ? cdf[cell - 1] : 0.0f);
   }
-  // The probability of triangle t that gives its point at `square` the density learned region r
-  // samples it with (EmitterSet::sampleTriangleByArea's `choice`: the cell's, times its cells).
-  float triangleChoice(uint32_t region, size_t triangle, glm::vec2 square) const {
-    return cellPmf(region, cellOf(triangle, square)) * float(grid_ * grid_);
+  // The probability of triangle t that gives its points in `cell` the density learned region r
+  // samples them with (EmitterSet::sampleTriangleByArea's `choice`): the cell's, times its cells on a
+  // grid, times the triangle's share of its group's area.
+  float triangleChoice(uint32_t region, size_t triangle, uint32_t cell) const {
+    return cellPmf(region, cell) * (grouped() ? areaShare_[triangle] : float(grid_ * grid_));
   }
   std::optional<LightSample> sampleLearned(const glm::vec3& p, uint32_t region, glm::vec2 u) const;
   Lane& lane() const;
 
   const RenderScene* scene_ = nullptr;
-  int grid_ = 1;   // cells per side of a triangle's square
+  int grid_ = 1;   // cells per side of a triangle's square (1 where grouped)
+  // Grouped: each triangle's group (its cell) and share of the group's area; per group, its triangles
+  // (from groupFirst_[g] to groupFirst_[g + 1] in groupTriangles_) and their cumulative area shares.
+  std::vector<uint32_t> groupOf_;
+  std::vector<float> areaShare_;
+  std::vector<uint32_t> groupFirst_, groupTriangles_;
+  std::vector<float> groupCdf_;
   int cells_ = 0;  // triangles x grid^2, then one per punctual light, then the sky's
   int punctualFirst_ = 0, skyFirst_ = 0;  // the first cells of punctual lights and of the sky
   glm::ivec3 regionsPerAxis_{1};

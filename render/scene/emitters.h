@@ -114,6 +114,8 @@ class EmitterSet {
   // pmf (its density: the light is a delta).
   std::optional<LightSample> samplePunctual(const glm::vec3& p, size_t index, float pmf) const;
   glm::vec3 triangleNormal(size_t index) const { return triangles_[index].normal; }
+  float triangleArea(size_t index) const { return triangles_[index].area; }
+  glm::vec3 triangleCentroid(size_t index) const { return triangles_[index].centre; }
   // The emitter index of a hit's triangle, or -1 where it does not emit.
   int32_t emitterOf(const SurfaceHit& hit) const;
   // The unit square's point that sampleUniformTriangle maps to x, a point of triangle `index`.

@@ -18,10 +18,14 @@ namespace {
 
 constexpr float kRoof = 1.0f, kLight = 1.5f, kHalf = 2.0f, kHole = 0.3f;
 
+// Where the light's tiles end along x and y: widening (so that its triangles differ in area).
+float tileEdge(int i, int tiles) { return -kHalf + 2.0f * kHalf * std::pow(float(i) / float(tiles), 1.5f); }
+
 // Floor at z = 0, four walls and a roof at z = kRoof over [-kHalf, kHalf]^2, the roof open over
 // [-kHole, kHole]^2; with `panel`, an emitting quad of [-kHalf, kHalf]^2 at z = kLight facing down
-// (else no light: the renderer's default sky). Everything else is grey Lambertian.
-SceneData skylightScene(bool panel = true) {
+// (else no light: the renderer's default sky), cut into tiles x tiles quads (tileEdge). Everything
+// else is grey Lambertian.
+SceneData skylightScene(bool panel = true, int tiles = 1) {
   SceneData s;
   Material grey;
   grey.baseColor = glm::vec3(0.5f);
@@ -41,7 +45,19 @@ SceneData skylightScene(bool panel = true) {
     m.material = material;
     s.meshes.push_back(m);
   };
-  if (panel) quad({-kHalf, -kHalf}, {kHalf, kHalf}, kLight, 1, true);  // mesh 0: the light, facing down
+  if (panel) {  // mesh 0: the light, facing down; quad (i, j) holds triangles 2 (j tiles + i) and the next
+    MeshData m;
+    for (int j = 0; j < tiles; ++j)
+      for (int i = 0; i < tiles; ++i) {
+        const glm::vec2 lo(tileEdge(i, tiles), tileEdge(j, tiles)), hi(tileEdge(i + 1, tiles), tileEdge(j + 1, tiles));
+        const auto first = uint32_t(m.positions.size());
+        for (const glm::vec2 corner : {lo, glm::vec2(hi.x, lo.y), hi, glm::vec2(lo.x, hi.y)})
+          m.positions.push_back(glm::vec3(corner, kLight));
+        for (uint32_t k : {0u, 2u, 1u, 0u, 3u, 2u}) m.indices.push_back(first + k);
+      }
+    m.material = 1;
+    s.meshes.push_back(m);
+  }
   quad({-kHalf, -kHalf}, {kHalf, kHalf}, 0.0f, 0, false);             // the floor
   const auto wall = [&](glm::vec3 a, glm::vec3 b) {  // a vertical rectangle from edge a-b up to the roof
     MeshData m;
@@ -79,18 +95,25 @@ struct Uniforms {
   }
 };
 
-// The light's point along p + t w (mesh 0, either triangle), as the surface hit a BSDF ray would make.
-std::optional<SurfaceHit> lightHit(const RenderScene& scene, const glm::vec3& p, const glm::vec3& w) {
+// The light's point along p + t w (mesh 0, cut into `tiles` x `tiles` quads), as the surface hit a
+// BSDF ray would make.
+std::optional<SurfaceHit> lightHit(const RenderScene& scene, const glm::vec3& p, const glm::vec3& w, int tiles = 1) {
   if (!(w.z > 0.0f)) return std::nullopt;
   const float t = (kLight - p.z) / w.z;
   const glm::vec3 x = p + t * w;
   if (std::abs(x.x) > kHalf || std::abs(x.y) > kHalf) return std::nullopt;
-  // The quad's diagonal runs from (-h, -h) to (h, h): triangle 0 (vertices 0, 2, 1) lies below it.
+  // A quad's diagonal runs from its (lo, lo) corner to (hi, hi): its first triangle (vertices 0, 2, 1)
+  // lies below it.
+  glm::ivec2 tile(0);
+  for (int axis = 0; axis < 2; ++axis)
+    while (tile[axis] + 1 < tiles && x[axis] >= tileEdge(tile[axis] + 1, tiles)) ++tile[axis];
+  const glm::vec2 lo(tileEdge(tile.x, tiles), tileEdge(tile.y, tiles));
+  const glm::vec2 within = (glm::vec2(x) - lo) / (glm::vec2(tileEdge(tile.x + 1, tiles), tileEdge(tile.y + 1, tiles)) - lo);
   SurfaceHit hit;
   hit.position = x;
   hit.geometricNormal = glm::vec3(0.0f, 0.0f, -1.0f);
   hit.mesh = 0;
-  hit.triangle = x.y <= x.x ? 0u : 1u;
+  hit.triangle = 2u * uint32_t(tile.y * tiles + tile.x) + (within.y <= within.x ? 0u : 1u);
   hit.frontFace = true;
   hit.coordinateScale = kHalf;
   (void)scene;
@@ -142,14 +165,14 @@ void expectLearningRaisesArrivals(const RenderScene& scene, EmitterGuide& guide,
 
 // Per sample the reported density equals pdf() at the hit, and the histogram of directions follows it.
 void expectDensityIsPdf(const RenderScene& scene, const EmitterGuide& guide, const glm::vec3& p, uint64_t seed,
-                        const std::string& what) {
+                        const std::string& what, int tiles = 1) {
   Uniforms u(seed);
   int compared = 0;
   for (int i = 0; i < 20000; ++i) {
     const float spare = u.next();
     const auto ls = guide.sample(p, u.next2(), [&] { return spare; });
     if (!ls) continue;
-    const auto hit = lightHit(scene, p, ls->wi);
+    const auto hit = lightHit(scene, p, ls->wi, tiles);
     ASSERT_TRUE(hit.has_value()) << what;
     ASSERT_NEAR(guide.pdf(p, *hit) / ls->pdf, 1.0, 2e-3) << what << ", sample " << i;
     ++compared;
@@ -163,34 +186,46 @@ void expectDensityIsPdf(const RenderScene& scene, const EmitterGuide& guide, con
         return ls ? ls->wi : glm::vec3(0.0f);
       },
       [&](const glm::vec3& w) {
-        const auto hit = lightHit(scene, p, w);
+        const auto hit = lightHit(scene, p, w, tiles);
         return hit ? double(guide.pdf(p, *hit)) : 0.0;
       },
       300000, 64, 128, 16);
   EXPECT_GT(chi.pValue, 1e-3) << what << ": " << chi.report;
 }
 
-TEST(EmitterGuide, LearnsWhatAnOpeningShowsAndKeepsItsDensityExact) {
-  const RenderScene scene(skylightScene());
+// The panel cut into tiles x tiles quads: its cells are a grid on each triangle up to kMaxCells
+// triangles, groups of triangles beyond. At least minArrivals of the samples from under the opening
+// arrive once it has learned.
+void expectLearnsWhatAnOpeningShows(int tiles, double minArrivals) {
+  const RenderScene scene(skylightScene(true, tiles));
   EmitterGuide guide(scene, true);
   ASSERT_TRUE(guide.active());
+  EXPECT_EQ(guide.cells(), EmitterGuide::kMaxCells) << tiles << " x " << tiles << " quads";
   const glm::vec3 underHole(0.05f, 0.05f, 0.01f);
-  expectDensityIsPdf(scene, guide, underHole, 3, "before learning");
+  expectDensityIsPdf(scene, guide, underHole, 3, "before learning", tiles);
   // The opening shows about (2 x 0.6)^2 / 4^2 = 9 % of the light from under it; with 70 % of the
   // choice learned, most samples should arrive.
-  expectLearningRaisesArrivals(scene, guide, underHole, 5, 0.2, 0.5, "the light through the opening");
-  expectDensityIsPdf(scene, guide, underHole, 11, "after learning");
+  expectLearningRaisesArrivals(scene, guide, underHole, 5, 0.2, minArrivals, "the light through the opening");
+  expectDensityIsPdf(scene, guide, underHole, 11, "after learning", tiles);
   // A light path's start, as the joins' weights ask for it: the same density times the light's cosine.
   Uniforms u(13);
   for (int i = 0; i < 1000; ++i) {
     const auto e = scene.emitters().sampleEmission(u.next(), u.next2(), u.next2());
     ASSERT_TRUE(e.has_value());
     const glm::vec3 d = e->position - underHole;
-    const auto hit = lightHit(scene, underHole, glm::normalize(d));
+    const auto hit = lightHit(scene, underHole, glm::normalize(d), tiles);
     ASSERT_TRUE(hit.has_value());
     const float cosLight = std::abs(d.z) / glm::length(d);
-    EXPECT_NEAR(guide.nextEventPdfTimesCos(underHole, *e) / (guide.pdf(underHole, *hit) * cosLight), 1.0, 2e-3);
+    ASSERT_NEAR(guide.nextEventPdfTimesCos(underHole, *e) / (guide.pdf(underHole, *hit) * cosLight), 1.0, 2e-3);
   }
+}
+
+TEST(EmitterGuide, LearnsWhatAnOpeningShowsAndKeepsItsDensityExact) { expectLearnsWhatAnOpeningShows(1, 0.5); }
+
+// 512 triangles of different areas: 128 groups of four, whose edges do not follow the opening's (0.49
+// arrive after learning, 0.05 before).
+TEST(EmitterGuide, GroupsTheTrianglesOfATessellatedLightAndKeepsItsDensityExact) {
+  expectLearnsWhatAnOpeningShows(16, 0.4);
 }
 
 // The sky's version: per sample the density equals pdfSky() in its direction, and the histogram over
@@ -290,6 +325,14 @@ TEST(EmitterGuide, BrdfConvergesToTheSameImageWithLearning) {
 // The joins weigh the learned density at their light paths' first vertices.
 TEST(EmitterGuide, MisConvergesToBrdfWithLearning) {
   expectLearningConvergesToBrdf(skylightScene(), SamplingMode::Mis, 300, "mis, learning on against brdf off");
+}
+
+TEST(EmitterGuide, BrdfConvergesToTheSameImageWithLearningOnATessellatedLight) {
+  expectLearningConvergesToBrdf(skylightScene(true, 16), SamplingMode::Brdf, 700, "brdf, 512 light triangles, learning on against off");
+}
+
+TEST(EmitterGuide, MisConvergesToBrdfWithLearningOnATessellatedLight) {
+  expectLearningConvergesToBrdf(skylightScene(true, 16), SamplingMode::Mis, 900, "mis, 512 light triangles, learning on against brdf off");
 }
 
 TEST(EmitterGuide, BrdfUnderTheSkyConvergesToTheSameImageWithLearning) {
