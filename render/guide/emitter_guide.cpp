@@ -183,7 +183,7 @@ void EmitterGuide::learnFromLastPass() {
     // of a small render's time.
     const bool deciding = state_[r] == State::Undecided && attempts_[r] >= kMinAttempts;
     if ((touched && state_[r] == State::Learned) || deciding) {
-      if (!tables_[r]) tables_[r] = std::make_unique<Table>(Table{std::vector<double>(size_t(cells_), 0.0), 0.0, {}});
+      if (!tables_[r]) tables_[r] = std::make_unique<Table>(Table{std::vector<double>(size_t(cells_), 0.0), 0.0, {}, {}});
       Table& t = *tables_[r];
       for (Lane& l : lanes_) {
         std::atomic<uint64_t>* block = l.sums[r].load(std::memory_order_acquire);
@@ -211,13 +211,22 @@ void EmitterGuide::learnFromLastPass() {
       t.cdf[size_t(c)] = float(cumulative);
     }
     t.cdf.back() = 1.0f;
+    t.cuts.resize(kCuts);
+    int cell = 0;
+    for (int k = 0; k < kCuts; ++k) {
+      while (cell + 1 < cells_ && t.cdf[size_t(cell)] <= float(k) / float(kCuts)) ++cell;
+      t.cuts[size_t(k)] = uint16_t(cell);
+    }
   }
 }
 
 std::optional<LightSample> EmitterGuide::sampleLearned(const glm::vec3& p, uint32_t region, glm::vec2 u) const {
-  const float* cdf = tables_[region]->cdf.data();
-  // The first cell whose cumulative probability passes u.x; u.x rescaled within it serves the point.
-  const uint32_t cell = uint32_t(std::min(int(std::upper_bound(cdf, cdf + cells_, u.x) - cdf), cells_ - 1));
+  const Table& table = *tables_[region];
+  const float* cdf = table.cdf.data();
+  // The first cell whose cumulative probability passes u.x (the last if none does); u.x rescaled
+  // within it serves the point.
+  uint32_t cell = table.cuts[size_t(std::min(int(u.x * float(kCuts)), kCuts - 1))];
+  while (cell + 1 < uint32_t(cells_) && cdf[cell] <= u.x) ++cell;
   const float low = cell > 0 ? cdf[cell - 1] : 0.0f, width = cdf[cell] - low;
   if (!(width > 0.0f)) return std::nullopt;
   const float x = std::clamp((u.x - low) / width, 0.0f, std::nextafter(1.0f, 0.0f));
@@ -245,7 +254,11 @@ std::optional<LightSample> EmitterGuide::sampleLearned(const glm::vec3& p, uint3
     // A triangle of the group by its share of the group's area (x rescaled once more), then its point.
     const uint32_t first = groupFirst_[cell], count = groupFirst_[cell + 1] - first;
     const float* shares = groupCdf_.data() + first;
-    const uint32_t k = uint32_t(std::min(int(std::upper_bound(shares, shares + count, x) - shares), int(count) - 1));
+    // The first triangle whose cumulative share passes x (the last if none does), from where it would
+    // be if the areas were equal: a step or two on a tessellated lamp.
+    uint32_t k = std::min(uint32_t(x * float(count)), count - 1);
+    while (k > 0 && shares[k - 1] > x) --k;
+    while (k + 1 < count && shares[k] <= x) ++k;
     const float before = k > 0 ? shares[k - 1] : 0.0f, share = shares[k] - before;
     if (!(share > 0.0f)) return std::nullopt;
     const size_t triangle = groupTriangles_[first + k];

@@ -124,7 +124,12 @@ class EmitterGuide {
     std::vector<double> sums;  // per cell
     double total = 0.0;
     std::vector<float> cdf;    // per cell, cumulative, the last exactly 1 (learned regions)
+    // Per k < kCuts: the first cell whose cdf passes k / kCuts, where the search for u in
+    // [k / kCuts, (k + 1) / kCuts) starts: a step or two instead of a binary search's mispredicted
+    // branches (which took 11 % of a brdf sample on lamp_rooms).
+    std::vector<uint16_t> cuts;
   };
+  static constexpr int kCuts = 256;
 
   uint32_t regionOf(const glm::vec3& p) const;
   bool grouped() const { return !groupOf_.empty(); }
