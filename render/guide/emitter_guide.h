@@ -168,7 +168,7 @@ class EmitterGuide {
   std::vector<float> areaShare_;
   std::vector<uint32_t> groupFirst_, groupTriangles_;
   std::vector<float> groupCdf_;
-  int cells_ = 0;  // triangles x grid^2, then one per punctual light, then the sky's
+  int cells_ = 0;  // triangles x grid^2 (or the groups), then one per punctual light, then the sky's
   int punctualFirst_ = 0, skyFirst_ = 0;  // the first cells of punctual lights and of the sky
   glm::ivec3 regionsPerAxis_{1};
   glm::vec3 low_{0.0f}, perUnit_{0.0f};
