@@ -6,6 +6,7 @@
 // check the samplers for any uniform input.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <numbers>
 #include <optional>
@@ -662,6 +663,71 @@ TEST(EmitterSampling, NextEventEstimateMatchesPolygonIrradiance) {
     const double mean = sum / n, se = std::sqrt(std::max(0.0, sum2 / n - mean * mean) / n);
     EXPECT_NEAR(mean, expected, 4.0 * se + 1e-9 * expected) << r.name << " (standard error " << se / expected << ")";
     EXPECT_LT(se / expected, 2e-3) << r.name << ": too noisy to see a 2 % error";
+  }
+}
+
+// A globe lamp of many small triangles (a latitude-longitude sphere of radius 0.15, wound outwards,
+// emitting from its outside), as lamp_rooms has: from a ceiling above it (the whole globe below the
+// receiver's tangent plane, and a convex globe hides none of its facets from another), the irradiance
+// is Lambert's formula summed over the facets that face the receiver. Its facets are seen at every
+// angle from head-on to grazing, each sampled by solid angle or by area.
+TEST(EmitterSampling, NextEventEstimateFromAGlobeMatchesPolygonIrradiance) {
+  SceneData scene;
+  Material light;
+  light.baseColor = glm::vec3(0.0f);
+  light.emission = glm::vec3(3.0f, 2.0f, 1.0f);
+  light.doubleSided = false;
+  scene.materials.push_back(light);
+  const glm::dvec3 centre(2.0, 2.2, -0.3);
+  const double radius = 0.15;
+  const int rings = 12, segments = 24;
+  MeshData globe;
+  for (int r = 0; r <= rings; ++r)
+    for (int k = 0; k < segments; ++k) {
+      const double theta = kPiD * r / rings, phi = 2.0 * kPiD * k / segments;
+      globe.positions.push_back(glm::vec3(centre + radius * glm::dvec3(std::sin(theta) * std::cos(phi), std::cos(theta),
+                                                                        std::sin(theta) * std::sin(phi))));
+    }
+  for (int r = 0; r < rings; ++r)
+    for (int k = 0; k < segments; ++k) {
+      const uint32_t a = uint32_t(r * segments + k), b = uint32_t(r * segments + (k + 1) % segments);
+      const uint32_t c = a + uint32_t(segments), d = b + uint32_t(segments);
+      if (r > 0) globe.indices.insert(globe.indices.end(), {a, b, c});
+      if (r + 1 < rings) globe.indices.insert(globe.indices.end(), {b, d, c});
+    }
+  globe.material = 0;
+  scene.meshes.push_back(globe);
+  scene.boundsMin = glm::vec3(0.0f);
+  scene.boundsMax = glm::vec3(4.0f, 2.8f, 2.0f);
+  const EmitterSet emitters(scene, glm::vec3(0.0f), glm::vec3(2.0f, 1.4f, 0.0f), 3.0f);
+  ASSERT_GT(emitters.triangleCount(), 400u);
+  const glm::dvec3 down(0.0, -1.0, 0.0);
+  for (const glm::dvec3 offset : {glm::dvec3(0.0, 0.0, 0.0), glm::dvec3(0.3, 0.0, 0.1), glm::dvec3(1.2, 0.0, -0.5)}) {
+    const glm::dvec3 p = glm::dvec3(centre.x, 2.8, centre.z) + offset;
+    double expected = 0.0;
+    for (size_t t = 0; t + 2 < globe.indices.size(); t += 3) {
+      const std::vector<glm::dvec3> v = {glm::dvec3(globe.positions[globe.indices[t]]), glm::dvec3(globe.positions[globe.indices[t + 1]]),
+                                         glm::dvec3(globe.positions[globe.indices[t + 2]])};
+      const glm::dvec3 n = glm::cross(v[1] - v[0], v[2] - v[0]);
+      if (glm::dot(n, p - v[0]) > 0.0) expected += 3.0 * polygonIrradiance(v, p, down);
+    }
+    Uniforms u(53);
+    const int samples = 4000000;
+    double sum = 0.0, sum2 = 0.0;
+    for (int s = 0; s < samples; ++s) {
+      const auto ls = emitters.sample(glm::vec3(p), u.next(), u.next2());
+      if (!ls) continue;
+      const double x = double(ls->radiance.x) * std::max(0.0, glm::dot(down, glm::dvec3(ls->wi))) / double(ls->pdf);
+      sum += x;
+      sum2 += x * x;
+    }
+    const double mean = sum / samples, se = std::sqrt(std::max(0.0, sum2 / samples - mean * mean) / samples);
+    EXPECT_NEAR(mean, expected, 4.0 * se + 1e-9 * expected) << "offset (" << offset.x << ", " << offset.z << "): "
+                                                             << (mean / expected - 1.0) * 100.0 << " %, standard error "
+                                                             << se / expected * 100.0 << " %";
+    EXPECT_LT(se / expected, 1e-3) << "too noisy to see a 0.5 % error";
+    std::printf("globe, offset (%g, %g): NEE %+.3f %% from Lambert's formula (standard error %.3f %%)\n", offset.x, offset.z,
+                (mean / expected - 1.0) * 100.0, se / expected * 100.0);
   }
 }
 
