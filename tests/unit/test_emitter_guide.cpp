@@ -11,6 +11,7 @@
 #include "render/guide/emitter_guide.h"
 #include "render/scene/render_scene.h"
 #include "tests/unit/pixel_agreement.h"
+#include "tests/unit/scene_builders.h"
 #include "tests/unit/support.h"
 
 namespace vpl {
@@ -27,13 +28,7 @@ float tileEdge(int i, int tiles) { return -kHalf + 2.0f * kHalf * std::pow(float
 // else is grey Lambertian.
 SceneData skylightScene(bool panel = true, int tiles = 1) {
   SceneData s;
-  Material grey;
-  grey.baseColor = glm::vec3(0.5f);
-  grey.metallic = 0.0f;
-  grey.roughness = 1.0f;
-  grey.specularFactor = 0.0f;
-  grey.doubleSided = true;
-  s.materials.push_back(grey);
+  s.materials.push_back(test::lambertian(0.5f));
   Material light;
   light.baseColor = glm::vec3(0.0f);
   light.emission = glm::vec3(4.0f, 3.0f, 2.0f);

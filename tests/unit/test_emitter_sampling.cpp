@@ -15,6 +15,7 @@
 #include "render/sampling/alias_table.h"
 #include "render/sampling/spherical_triangle.h"
 #include "render/scene/emitters.h"
+#include "tests/unit/scene_builders.h"
 #include "tests/unit/support.h"
 
 namespace vpl {
@@ -430,18 +431,7 @@ std::optional<EmitterHit> traceEmitters(const SceneData& scene, const glm::dvec3
   return best;
 }
 
-// Irradiance at p (normal n) from a uniform Lambertian polygon of radiance 1, by Lambert's
-// formula: (1/2) sum_i angle(a_i, a_i+1) n . unit(a_i x a_i+1), a_i the vertices minus p. Holds when
-// the polygon lies wholly above p's tangent plane.
-double polygonIrradiance(const std::vector<glm::dvec3>& vertices, const glm::dvec3& p, const glm::dvec3& n) {
-  double sum = 0.0;
-  for (size_t i = 0; i < vertices.size(); ++i) {
-    const glm::dvec3 a = glm::normalize(vertices[i] - p), b = glm::normalize(vertices[(i + 1) % vertices.size()] - p);
-    const glm::dvec3 c = glm::cross(a, b);
-    sum += std::atan2(glm::length(c), glm::dot(a, b)) * glm::dot(n, glm::normalize(c));
-  }
-  return 0.5 * std::abs(sum);
-}
+using test::polygonIrradiance;
 
 struct Receiver {
   const char* name;
@@ -670,7 +660,7 @@ TEST(EmitterSampling, NextEventEstimateMatchesPolygonIrradiance) {
 // emitting from its outside), as lamp_rooms has: from a ceiling above it (the whole globe below the
 // receiver's tangent plane, and a convex globe hides none of its facets from another), the irradiance
 // is Lambert's formula summed over the facets that face the receiver. Its facets are seen at every
-// angle from head-on to grazing, each sampled by solid angle or by area.
+// angle from head-on to grazing (from here, each sampled by area).
 TEST(EmitterSampling, NextEventEstimateFromAGlobeMatchesPolygonIrradiance) {
   SceneData scene;
   Material light;
@@ -679,23 +669,7 @@ TEST(EmitterSampling, NextEventEstimateFromAGlobeMatchesPolygonIrradiance) {
   light.doubleSided = false;
   scene.materials.push_back(light);
   const glm::dvec3 centre(2.0, 2.2, -0.3);
-  const double radius = 0.15;
-  const int rings = 12, segments = 24;
-  MeshData globe;
-  for (int r = 0; r <= rings; ++r)
-    for (int k = 0; k < segments; ++k) {
-      const double theta = kPiD * r / rings, phi = 2.0 * kPiD * k / segments;
-      globe.positions.push_back(glm::vec3(centre + radius * glm::dvec3(std::sin(theta) * std::cos(phi), std::cos(theta),
-                                                                        std::sin(theta) * std::sin(phi))));
-    }
-  for (int r = 0; r < rings; ++r)
-    for (int k = 0; k < segments; ++k) {
-      const uint32_t a = uint32_t(r * segments + k), b = uint32_t(r * segments + (k + 1) % segments);
-      const uint32_t c = a + uint32_t(segments), d = b + uint32_t(segments);
-      if (r > 0) globe.indices.insert(globe.indices.end(), {a, b, c});
-      if (r + 1 < rings) globe.indices.insert(globe.indices.end(), {b, d, c});
-    }
-  globe.material = 0;
+  const MeshData globe = test::globe(centre, 0.15, 12, 24, 0);
   scene.meshes.push_back(globe);
   scene.boundsMin = glm::vec3(0.0f);
   scene.boundsMax = glm::vec3(4.0f, 2.8f, 2.0f);
@@ -704,19 +678,20 @@ TEST(EmitterSampling, NextEventEstimateFromAGlobeMatchesPolygonIrradiance) {
   const glm::dvec3 down(0.0, -1.0, 0.0);
   for (const glm::dvec3 offset : {glm::dvec3(0.0, 0.0, 0.0), glm::dvec3(0.3, 0.0, 0.1), glm::dvec3(1.2, 0.0, -0.5)}) {
     const glm::dvec3 p = glm::dvec3(centre.x, 2.8, centre.z) + offset;
-    double expected = 0.0;
-    for (size_t t = 0; t + 2 < globe.indices.size(); t += 3) {
-      const std::vector<glm::dvec3> v = {glm::dvec3(globe.positions[globe.indices[t]]), glm::dvec3(globe.positions[globe.indices[t + 1]]),
-                                         glm::dvec3(globe.positions[globe.indices[t + 2]])};
-      const glm::dvec3 n = glm::cross(v[1] - v[0], v[2] - v[0]);
-      if (glm::dot(n, p - v[0]) > 0.0) expected += 3.0 * polygonIrradiance(v, p, down);
-    }
+    const double expected = 3.0 * test::convexMeshIrradiance(globe, p, down);
     Uniforms u(53);
     const int samples = 4000000;
     double sum = 0.0, sum2 = 0.0;
+    int compared = 0;
     for (int s = 0; s < samples; ++s) {
       const auto ls = emitters.sample(glm::vec3(p), u.next(), u.next2());
       if (!ls) continue;
+      if (s % 100 == 0) {  // the density an emitter hit along the sample's direction is weighed with
+        const auto e = traceEmitters(scene, p, glm::dvec3(ls->wi));
+        ASSERT_TRUE(e.has_value());
+        EXPECT_NEAR(emitters.pdfTriangle(glm::vec3(p), e->hit) / ls->pdf, 1.0, 2e-3) << "sample " << s;
+        ++compared;
+      }
       const double x = double(ls->radiance.x) * std::max(0.0, glm::dot(down, glm::dvec3(ls->wi))) / double(ls->pdf);
       sum += x;
       sum2 += x * x;

@@ -1,6 +1,8 @@
 // The reference path tracer (`brdf`) against analytic answers, and its determinism. Its agreement with
 // an independent renderer on whole scenes is test_cycles_anchor.
 #include <cmath>
+#include <numbers>
+#include <cstdio>
 #include <string>
 #include <tuple>
 #include <tbb/global_control.h>
@@ -164,6 +166,48 @@ TEST(WhiteFurnace, GlossyMetalNeverGainsEnergy) {
   const MeanAndError m = channelMean(r.image, 1);
   EXPECT_LE(m.mean, 0.5 * (depth + 1) + 4.0 * m.error);
   EXPECT_GT(m.mean, 0.5);  // it does reflect something
+}
+
+// Direct light from a globe lamp of 528 small triangles onto a Lambertian ceiling 0.15 m above its top,
+// through the whole path tracer (next-event estimation, emitter hits of BSDF rays, their MIS
+// weights, the shadow rays ending short of the lamp): a patch of the ceiling a millimetre wide has
+// radiance albedo / pi x Lambert's formula over the globe's facets that face it. Shadow rays
+// parallel to the light sample's direction from the offset origin ended on the lamp's facets seen at
+// grazing angles, for a fifth of the samples: 3.7 % too dark (2.9 % with the globe 0.6 m below).
+TEST(PathTracer, DirectLightFromAGlobeMatchesLambertsFormula) {
+  SceneData s;
+  s.materials.push_back(test::lambertian(0.5f));
+  Material lamp;
+  lamp.baseColor = glm::vec3(0.0f);
+  lamp.emission = glm::vec3(3.0f, 2.0f, 1.0f);
+  lamp.doubleSided = false;
+  s.materials.push_back(lamp);
+  MeshData plane;
+  plane.positions = {{0.0f, 2.8f, -2.0f}, {4.0f, 2.8f, -2.0f}, {4.0f, 2.8f, 2.0f}, {0.0f, 2.8f, 2.0f}};
+  plane.indices = {0, 1, 2, 0, 2, 3};  // its normal faces down
+  plane.material = 0;
+  s.meshes.push_back(plane);
+  const MeshData globe = test::globe(glm::dvec3(2.0, 2.5, -0.3), 0.15, 12, 24, 1);
+  s.meshes.push_back(globe);
+  s.boundsMin = glm::vec3(0.0f, 2.0f, -2.0f);
+  s.boundsMax = glm::vec3(4.0f, 2.8f, 2.0f);
+  const glm::dvec3 p(2.3, 2.8, -0.2), down(0.0, -1.0, 0.0);
+  CameraData camera;
+  camera.eye = glm::vec3(p + glm::dvec3(0.6, -0.5, 0.3));
+  camera.target = glm::vec3(p);
+  camera.yfov = 1e-3f;
+  s.camera = camera;
+  const RenderScene scene(s);
+  const Rendered r = renderScene(scene, 4, 4, 65536, 17, 3);
+  const double irradiance = test::convexMeshIrradiance(globe, p, down);
+  for (int c = 0; c < 3; ++c) {
+    const double expected = 0.5 / std::numbers::pi * double(lamp.emission[c]) * irradiance;
+    const MeanAndError m = channelMean(r.image, c);
+    EXPECT_NEAR(m.mean, expected, 4.0 * m.error + 1e-6 * expected) << "channel " << c;
+    EXPECT_LT(m.error / expected, 1.5e-3) << "too noisy to see a 1 % error";
+    std::printf("globe on a ceiling, channel %d: %+.3f %% from Lambert's formula (standard error %.3f %%)\n", c,
+                (m.mean / expected - 1.0) * 100.0, m.error / expected * 100.0);
+  }
 }
 
 TEST(PathTracer, SameSeedSameImageForAnyThreadCount) {

@@ -6,6 +6,7 @@
 // every VPL and cluster budget at 1.
 #include <cmath>
 #include "render/session/render_job.h"
+#include "tests/unit/scene_builders.h"
 #include "tests/unit/support.h"
 
 namespace vpl {
@@ -32,16 +33,6 @@ SceneData skyPlane(const Material& material, float tilt) {
   camera.yfov = 0.2f * tilt;
   s.camera = camera;
   return s;
-}
-
-Material diffuse(float albedo) {
-  Material m;
-  m.baseColor = glm::vec3(albedo);
-  m.metallic = 0.0f;
-  m.roughness = 1.0f;
-  m.specularFactor = 0.0f;
-  m.doubleSided = true;
-  return m;
 }
 
 Material whiteMetal(float roughness) {
@@ -96,7 +87,7 @@ constexpr float kGrazing = 1e-3f, kModerate = 0.6f;
 TEST(SkyPlane, LambertianPlaneIsAlbedoTimesSkyAtGrazingAndModerateViews) {
   for (float tilt : {kGrazing, kModerate})
     for (SamplingMode mode : kModes) {
-      const Stats st = render(diffuse(0.5f), tilt, mode);
+      const Stats st = render(test::lambertian(0.5f), tilt, mode);
       ASSERT_TRUE(st.finite) << modeName(mode) << " tilt " << tilt;
       EXPECT_NEAR(st.mean, 0.5, 4.0 * st.error + 0.01) << modeName(mode) << " tilt " << tilt;
     }
@@ -104,10 +95,10 @@ TEST(SkyPlane, LambertianPlaneIsAlbedoTimesSkyAtGrazingAndModerateViews) {
 
 TEST(SkyPlane, AlbedoZeroAndOneStayWithinTheirBounds) {
   for (SamplingMode mode : kModes) {
-    const Stats black = render(diffuse(0.0f), kGrazing, mode);
+    const Stats black = render(test::lambertian(0.0f), kGrazing, mode);
     EXPECT_TRUE(black.finite);
     EXPECT_EQ(black.max, 0.0) << modeName(mode);
-    const Stats white = render(diffuse(1.0f), kGrazing, mode);
+    const Stats white = render(test::lambertian(1.0f), kGrazing, mode);
     EXPECT_TRUE(white.finite);
     EXPECT_NEAR(white.mean, 1.0, 4.0 * white.error + 0.01) << modeName(mode);  // energy neither gained nor lost
   }
@@ -131,7 +122,7 @@ TEST(SkyPlane, SmoothWhiteMetalMirrorsTheSkyAndRoughOneNeverGainsEnergy) {
 
 TEST(SkyPlane, EveryBudgetAtOneStaysFiniteAndUnbiasedWhereItMustBe) {
   for (SamplingMode mode : kModes) {
-    const Stats st = render(diffuse(0.5f), kModerate, mode, /*budgetsAtOne=*/true);
+    const Stats st = render(test::lambertian(0.5f), kModerate, mode, /*budgetsAtOne=*/true);
     ASSERT_TRUE(st.finite) << modeName(mode);
     // One segment: the sky seen directly by next-event estimation and the BSDF, in every mode.
     EXPECT_NEAR(st.mean, 0.5, 4.0 * st.error + 0.02) << modeName(mode);

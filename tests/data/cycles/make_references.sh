@@ -8,8 +8,8 @@
 # glossy layers, metallic 0 with specularFactor 1) and the generated interior (the same).
 # door_ajar maps but is not used (see the test's header).
 # Usage, from the repository root: tests/data/cycles/make_references.sh [BUILD_DIR] [SCENE...]
-# (default: build, every scene below; BUILD_DIR holds the generated scenes/skylit_hall.glb). 1-2 min
-# for cornell_box, about 6 for two_rooms and 5 for skylit_hall, on 2 idle cores; needs
+# (default: build, every scene below; BUILD_DIR holds the generated scenes/skylit_hall.glb and
+# lamp_rooms.glb). 1-2 min for cornell_box, about 6 for two_rooms, 5 for skylit_hall and 2 for lamp_rooms, on 2 idle cores; needs
 # `apt-get install blender python3-numpy`.
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/../../.." && pwd)
@@ -18,7 +18,7 @@ shift || true
 tool=$repo/../shared/tools/cycles/cycles-render
 out=$repo/tests/data/cycles
 . "$repo/bench/lib.sh"
-for scene in ${*:-cornell_box two_rooms skylit_hall}; do
+for scene in ${*:-cornell_box two_rooms skylit_hall lamp_rooms}; do
   file=$(scene_file "$repo" "$build" "$scene" make_references)
   for seed in 1 2 3 4 5 6 7 8; do
     "$tool" "$file" "$out/${scene}_seed$seed.exr" \
