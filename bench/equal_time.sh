@@ -3,7 +3,7 @@
 # sampling change (bench/vs_cycles.sh is the full table against Cycles).
 #
 # Usage: bench/equal_time.sh BUILD_DIR REF_DIR SECONDS SEED 'LABEL|FLAGS;LABEL|FLAGS...' SCENE...
-#   REF_DIR holds ref_SCENE_*.exr (the references bench/vs_cycles.sh caches; with REF_MODE=MODE set, the
+#   REF_DIR holds ref_SCENE_*_revR_*.exr (the references bench/vs_cycles.sh caches, R = REF_REVISION; with REF_MODE=MODE set, the
 #   ones it made with that REF_MODE, ref_SCENE_*_MODE.exr, else the brdf ones); the Cornell box renders at
 #   256x256, other scenes at 320x240, 2 threads, max depth 32. Prints one line per scene and variant:
 #   scene, label, spp, mis's BSDF probability (learned: the mean), the join depth --join-depth auto chose, relMSE.
@@ -21,11 +21,11 @@ trap 'rm -rf "$tmp"' EXIT
 for name in "$@"; do
   scene=$(scene_file "$here" "$build" "$name" equal_time)
   if [ -n "${REF_MODE:-}" ] && [ "$REF_MODE" != brdf ]; then
-    ref=$(ls "$refs"/ref_"$name"_*_"$REF_MODE".exr 2>/dev/null | head -1 || true)
+    ref=$(ls "$refs"/ref_"$name"_*_rev"$REF_REVISION"_*_"$REF_MODE".exr 2>/dev/null | head -1 || true)
   else
-    ref=$(ls "$refs"/ref_"$name"_*.exr 2>/dev/null | grep -Ev '_(metropolis|mis|mixture|preview)[.]exr$' | head -1 || true)
+    ref=$(ls "$refs"/ref_"$name"_*_rev"$REF_REVISION"_*.exr 2>/dev/null | grep -Ev '_(metropolis|mis|mixture|preview)[.]exr$' | head -1 || true)
   fi
-  [ -n "$ref" ] || { echo "equal_time: no reference ref_${name}_*.exr in $refs" >&2; exit 2; }
+  [ -n "$ref" ] || { echo "equal_time: no reference ref_${name}_*_rev${REF_REVISION}_*.exr in $refs (bench/lib.sh)" >&2; exit 2; }
   size=(--width 320 --height 240)
   [ "$name" = cornell_box ] && size=(--width 256 --height 256)
   for config in "${configs[@]}"; do

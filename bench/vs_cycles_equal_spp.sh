@@ -31,7 +31,7 @@ refs=()  # "scene: reference file" for the table's footnote
 for name in $SCENES; do
   scene=$here/scenes/$name.gltf
   if [ "$name" = cornell_box ]; then W=256 H=256; else W=320 H=240; fi
-  ref=$(ls "$out"/ref_"${name}"_*_${W}x${H}_*spp_d${MAX_DEPTH}$(ref_suffix "$REF_MODE").exr 2>/dev/null | head -1)
+  ref=$(ls "$out"/ref_"${name}"_*_rev${REF_REVISION}_${W}x${H}_*spp_d${MAX_DEPTH}$(ref_suffix "$REF_MODE").exr 2>/dev/null | head -1)
   [ -n "$ref" ] || { echo "vs_cycles_equal_spp: no reference for $name in $out (run bench/vs_cycles.sh first)" >&2; exit 2; }
   refs+=("$name: $(basename "$ref")")
   for n in $counts; do
