@@ -117,8 +117,8 @@ Ray spawnShadowRay(const SurfaceHit& from, const glm::vec3& wi, float distance) 
   if (!std::isfinite(distance)) return r;
   // Aimed from the offset origin at the light point itself: a ray parallel to wi from there meets a
   // light seen at a grazing angle up to offset / sin(angle) before the point, on the light's own
-  // surface (a ceiling 0.3 m above a globe lamp of 528 facets: a fifth of the shadow rays ended on the
-  // lamp, the ceiling 3.7 % too dark). Then stop short of the point by a margin that covers both a
+  // surface (a ceiling 0.15 m above a globe lamp of 528 facets: a fifth of the shadow rays ended on
+  // the lamp, the ceiling 3.6 % too dark). Then stop short of the point by a margin that covers both a
   // relative error of the distance and the light's own surface offset (coordinates there are of the
   // same size as here). A margin of the distance alone let rays between close, parallel surfaces far
   // from the origin end on the light itself.
