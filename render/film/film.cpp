@@ -20,18 +20,20 @@ void Film::addSample(int x, int y, const glm::vec3& L) {
   addTo(p.b, L.z);
   const double l = luminance(L);
   addTo(p.lum2, l * l);
+  addTo(p.weight, 1.0);
   p.count.store(p.count.load(kRelaxed) + 1, kRelaxed);
 }
 
-void Film::add(const Film& other) {
+void Film::add(const Film& other, double weight) {
   if (other.width_ != width_ || other.height_ != height_) return;
   for (size_t i = 0, n = size_t(width_) * size_t(height_); i < n; ++i) {
     Pixel& p = pixels_[i];
     const Pixel& o = other.pixels_[i];
-    addTo(p.r, o.r.load(kRelaxed));
-    addTo(p.g, o.g.load(kRelaxed));
-    addTo(p.b, o.b.load(kRelaxed));
-    addTo(p.lum2, o.lum2.load(kRelaxed));
+    addTo(p.r, weight * o.r.load(kRelaxed));
+    addTo(p.g, weight * o.g.load(kRelaxed));
+    addTo(p.b, weight * o.b.load(kRelaxed));
+    addTo(p.lum2, weight * o.lum2.load(kRelaxed));
+    addTo(p.weight, weight * o.weight.load(kRelaxed));
     p.count.store(p.count.load(kRelaxed) + o.count.load(kRelaxed), kRelaxed);
   }
 }
@@ -42,6 +44,7 @@ void Film::clear() {
     pixels_[i].g.store(0, kRelaxed);
     pixels_[i].b.store(0, kRelaxed);
     pixels_[i].lum2.store(0, kRelaxed);
+    pixels_[i].weight.store(0, kRelaxed);
     pixels_[i].count.store(0, kRelaxed);
   }
 }
@@ -50,9 +53,9 @@ Image Film::resolve() const {
   Image image(width_, height_);
   for (size_t i = 0; i < image.pixels.size(); ++i) {
     const Pixel& p = pixels_[i];
-    const uint32_t n = p.count.load(kRelaxed);
-    if (n == 0) continue;
-    const double inv = 1.0 / n;
+    const double w = p.weight.load(kRelaxed);
+    if (p.count.load(kRelaxed) == 0 || !(w > 0.0)) continue;
+    const double inv = 1.0 / w;
     image.pixels[i] = glm::vec3(float(p.r.load(kRelaxed) * inv), float(p.g.load(kRelaxed) * inv), float(p.b.load(kRelaxed) * inv));
   }
   return image;
@@ -63,9 +66,10 @@ Image Film::resolveVariance() const {
   for (size_t i = 0; i < image.pixels.size(); ++i) {
     const Pixel& p = pixels_[i];
     const uint32_t n = p.count.load(kRelaxed);
-    if (n < 2) continue;
-    const double mean = luminance(glm::vec3(float(p.r.load(kRelaxed)), float(p.g.load(kRelaxed)), float(p.b.load(kRelaxed)))) / n;
-    const double var = std::max(0.0, (p.lum2.load(kRelaxed) / n - mean * mean) * n / (n - 1));
+    const double w = p.weight.load(kRelaxed);
+    if (n < 2 || !(w > 0.0)) continue;
+    const double mean = luminance(glm::vec3(float(p.r.load(kRelaxed)), float(p.g.load(kRelaxed)), float(p.b.load(kRelaxed)))) / w;
+    const double var = std::max(0.0, (p.lum2.load(kRelaxed) / w - mean * mean) * n / (n - 1));
     image.pixels[i] = glm::vec3(float(var / n / (mean * mean + 1e-4)));
   }
   return image;
@@ -76,9 +80,10 @@ double Film::sampleRelativeVariance() const {
   for (size_t i = 0, n = size_t(width_) * size_t(height_); i < n; ++i) {
     const Pixel& p = pixels_[i];
     const uint32_t count = p.count.load(kRelaxed);
-    if (count < 2) continue;
-    const double mean = luminance(glm::vec3(float(p.r.load(kRelaxed)), float(p.g.load(kRelaxed)), float(p.b.load(kRelaxed)))) / count;
-    variance += std::max(0.0, (p.lum2.load(kRelaxed) / count - mean * mean) * count / (count - 1));
+    const double w = p.weight.load(kRelaxed);
+    if (count < 2 || !(w > 0.0)) continue;
+    const double mean = luminance(glm::vec3(float(p.r.load(kRelaxed)), float(p.g.load(kRelaxed)), float(p.b.load(kRelaxed)))) / w;
+    variance += std::max(0.0, (p.lum2.load(kRelaxed) / w - mean * mean) * count / (count - 1));
     mean2 += mean * mean;
   }
   return mean2 > 0.0 ? variance / mean2 : 0.0;

@@ -1,5 +1,7 @@
-// The accumulation buffer of a progressive render: per pixel, a sum of radiance samples, a sum of
-// squared luminance (for the relative-variance view) and a sample count.
+// The accumulation buffer of a progressive render: per pixel, a weighted sum of radiance samples, a
+// weighted sum of squared luminance (for the relative-variance view), the sum of the weights and a
+// sample count. A sample added by addSample() weighs 1; add() can weigh a whole film's samples less
+// (`--join-depth auto`'s trial passes), and the mean is then the weighted mean.
 //
 // Threading contract: workers call addSample() only for pixels of tiles they own (no two threads
 // write one pixel at once); any thread may call resolve() at any time. Fields are relaxed atomics,
@@ -21,11 +23,11 @@ class Film {
   int height() const { return height_; }
 
   void addSample(int x, int y, const glm::vec3& radiance);
-  // Adds another film's samples of the same size (its sums and counts), as if they had been added here.
-  void add(const Film& other);
+  // Adds another film's samples of the same size, each weighing `weight` times what it weighed there.
+  void add(const Film& other, double weight = 1.0);
   void clear();
 
-  Image resolve() const;           // per-pixel mean; pixels without samples are black
+  Image resolve() const;           // per-pixel weighted mean; pixels without samples are black
   Image resolveVariance() const;   // per-pixel relative variance of the mean luminance, in all channels
   uint64_t totalSamples() const;
   // The image's relative variance per sample, brightness-weighted: the sum over pixels of the
@@ -34,7 +36,7 @@ class Film {
 
  private:
   struct Pixel {
-    std::atomic<double> r{0}, g{0}, b{0}, lum2{0};
+    std::atomic<double> r{0}, g{0}, b{0}, lum2{0}, weight{0};
     std::atomic<uint32_t> count{0};
   };
   int width_, height_;

@@ -32,14 +32,14 @@ Film& JoinDepthTrial::beginPass(uint64_t slot, Film& image, LightVertexCache& jo
   return *passFilm_;
 }
 
-void JoinDepthTrial::endPass(uint64_t slot, Film& image, bool complete, double seconds) {
+void JoinDepthTrial::endPass(uint64_t slot, Film& image, bool complete, double rays) {
   if (slot + 1 == kFirstPass && complete) {
     start(image);
     passFilm_.emplace(image.width(), image.height());
   }
   if (!isTrialPass(slot) || !passFilm_) return;
-  if (complete) record(slot, *passFilm_, seconds);
-  image.add(*passFilm_);
+  if (complete) record(slot, *passFilm_, rays);
+  image.add(*passFilm_, kTrialPassWeight);
   if (decided_) passFilm_.reset();
 }
 
@@ -48,7 +48,7 @@ int JoinDepthTrial::depthFor(uint64_t pass) const {
   return decided_ ? chosen_ : kCandidates[0];
 }
 
-void JoinDepthTrial::record(uint64_t pass, const Film& passFilm, double seconds) {
+void JoinDepthTrial::record(uint64_t pass, const Film& passFilm, double rays) {
   if (!isTrialPass(pass) || decided_) return;
   const size_t c = candidateOf(pass);
   const Image image = passFilm.resolve();
@@ -58,7 +58,7 @@ void JoinDepthTrial::record(uint64_t pass, const Film& passFilm, double seconds)
     sum_[c][i] += l;
     sum2_[c][i] += l * l;
   }
-  seconds_[c] += seconds;
+  rays_[c] += rays;
   ++passes_[c];
   if (pass == kLastPass) decide();
 }
@@ -87,7 +87,7 @@ void JoinDepthTrial::decide() {
     for (size_t g = 0; g < kGroups; ++g)
       if (groupPixels[g] > 0) means[used++] = groupSum[c][g] / double(groupPixels[g]);
     std::nth_element(means.begin(), means.begin() + used / 2, means.begin() + used);
-    scores_[c] = means[used / 2] * seconds_[c] / passes_[c];
+    scores_[c] = means[used / 2] * rays_[c] / passes_[c];
     if (!std::isfinite(scores_[c])) scores_[c] = INFINITY;
     if (scores_[c] < scores_[best]) best = c;
   }

@@ -13,20 +13,21 @@
 // Nor is depth 2: two passes rarely show its rare bright samples, so it won the trial on two_rooms
 // where it loses (32 spp, 3 seeds: 1.26x the relMSE at 0.9x the time).
 //
-// Opt-in, not the default: at 32 spp (3 seeds, README) it gained 4 % of relMSE x time on the Cornell
-// box, at 128 spp nothing beyond the timing noise, and it loses 15 % on door_ajar at 32 spp, where
-// the two passes of depth 1 it keeps are 2-4x worse per sample; the trial's share of the passes,
-// and so that loss, falls as 1/spp (3-4 % at 128 spp).
+// The trial's passes count for half as much as the others in the image (kTrialPassWeight), the same
+// for both candidates and fixed before any of them ran, so the image stays unbiased while the losing
+// depth's passes, up to 2-4x worse per sample on door_ajar, add a quarter of their variance.
 //
 // Every pass is an unbiased estimate whatever its depth (the MIS weights leave out exactly the
 // joins a depth forbids), and the choice depends only on earlier passes, so the image stays
-// unbiased. It is not deterministic in the seed, though: the choice rests on measured seconds, so
-// on a near tie a loaded machine or another thread count may choose the other depth.
+// unbiased. A candidate's cost is the rays its passes traced (the light paths' included), not their
+// seconds: the time of a pass follows its rays (2.03x the render phase for 2.02x the rays, mis
+// against brdf on the Cornell box), and rays keep the choice, and so the image, deterministic in the
+// seed whatever the machine's load or the thread count.
 //
 // The measure, per candidate: the mean over pixels of its passes' sample variance of luminance,
 // each pixel weighted by 1 / (m^2 + 0.01), m the image of the passes before the trial (relMSE's
 // weights, DESIGN.md §4, with that image in place of the reference), taken as the median over nine
-// interleaved groups of rows, times the candidate's mean seconds per pass, its light paths included.
+// interleaved groups of rows, times the candidate's mean rays per pass, its light paths' included.
 // The weights must not come from the trial's own passes: a candidate's rare bright sample would
 // raise its pixel's mean and so hide its own variance (door_ajar then chose depth 0, which has 4x
 // the relMSE of every vertex there at 16 spp).
@@ -49,6 +50,8 @@ class JoinDepthTrial {
   // candidate is timed with the tracer that the rest of the render uses.
   static constexpr uint64_t kFirstPass = 4;
   static constexpr uint64_t kLastPass = kFirstPass + kCandidates.size() * kPassesEach - 1;
+  // What a trial pass's samples weigh in the image, against 1 for any other pass.
+  static constexpr double kTrialPassWeight = 0.5;
 
   JoinDepthTrial(int width, int height);
 
@@ -56,10 +59,10 @@ class JoinDepthTrial {
   // vertices are built: sets the depth the joins use and returns the film to render into, the image
   // itself or, during a prepared trial (endPass), a film of the pass's own.
   Film& beginPass(uint64_t slot, Film& image, LightVertexCache& joins);
-  // After the pass: a complete trial pass is recorded with its seconds (light paths included: a
-  // depth's cost is the whole pass's), and its samples join the image either way. The complete pass
-  // before the trial prepares it (start() and the pass film), so that neither is timed as a candidate's.
-  void endPass(uint64_t slot, Film& image, bool complete, double seconds);
+  // After the pass: a complete trial pass is recorded with the rays it traced (light paths included:
+  // a depth's cost is the whole pass's), and its samples join the image either way, weighing
+  // kTrialPassWeight. The complete pass before the trial prepares it (start() and the pass film).
+  void endPass(uint64_t slot, Film& image, bool complete, double rays);
 
   // Before the first trial pass: the image so far, whose luminance weighs the pixels.
   void start(const Film& film);
@@ -74,12 +77,12 @@ class JoinDepthTrial {
     if (pass > kLastPass && !decided_) decide();
     return depthFor(pass);
   }
-  // A complete trial pass's own film (one sample per pixel) and its wall time. The last one decides.
-  void record(uint64_t pass, const Film& passFilm, double seconds);
+  // A complete trial pass's own film (one sample per pixel) and its rays. The last one decides.
+  void record(uint64_t pass, const Film& passFilm, double rays);
 
   bool decided() const { return decided_; }
   int chosen() const { return chosen_; }
-  // Per candidate: relative variance per pass times seconds per pass (0 before the decision).
+  // Per candidate: relative variance per pass times rays per pass (0 before the decision).
   const std::array<double, kCandidates.size()>& scores() const { return scores_; }
 
  private:
@@ -101,7 +104,7 @@ class JoinDepthTrial {
   std::vector<double> weight_;  // per pixel: 1 / (m^2 + 0.01), m from start()
   // Per candidate and pixel: the sum and sum of squares of the passes' luminance.
   std::array<std::vector<double>, kCandidates.size()> sum_, sum2_;
-  std::array<double, kCandidates.size()> seconds_{}, scores_{};
+  std::array<double, kCandidates.size()> rays_{}, scores_{};
   std::array<int, kCandidates.size()> passes_{};
   bool decided_ = false;
   int chosen_ = -1;

@@ -170,7 +170,6 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
   for (uint64_t pass = 0;; ++pass) {
     if (!timed && int(pass) >= settings.spp) break;
     if (timed && pass > 0 && stop.load()) break;
-    const auto passStart = Clock::now();
     emitterGuide.learnFromLastPass();
     if (connecting) {
       const auto t = Clock::now();
@@ -182,7 +181,8 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
     Film& target = joinTrial ? joinTrial->beginPass(pass, film, connectionCache) : film;
     // The first pass always completes: a budget never leaves an empty image.
     const PassStats stats = renderer->renderPass(target, pass, pass == 0 ? nullptr : &stop);
-    if (joinTrial) joinTrial->endPass(pass, film, !(timed && stop.load()), secondsSince(passStart));
+    if (joinTrial)
+      joinTrial->endPass(pass, film, !(timed && stop.load()), double(stats.rays + (connecting ? connectionCache.rays() : 0)));
     result.rays += stats.rays;
     result.samples += stats.samples;
     result.discarded += stats.discarded;

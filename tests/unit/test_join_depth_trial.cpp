@@ -1,5 +1,5 @@
 // `--join-depth auto`'s decision (render/session/join_depth_trial.h): the candidate of least variance
-// x time wins, a single bright sample does not decide, and the pixels are weighed by the image before
+// x rays wins, a single bright sample does not decide, and the pixels are weighed by the image before
 // the trial. That every depth, and so every mix of them, keeps the image unbiased is checked pixel
 // by pixel against brdf (test_guided_modes, cornell_box_mis_join_depth_auto) and by the furnace.
 #include <functional>
@@ -15,9 +15,9 @@ namespace {
 constexpr int kSize = 36;
 
 // Runs a whole trial: the image so far is `mean` everywhere, and each trial pass of candidate c
-// draws every pixel from sample(c, rng), taking seconds[c].
+// draws every pixel from sample(c, rng), tracing rays[c].
 JoinDepthTrial runTrial(float mean, const std::function<float(size_t, Rng&)>& sample,
-                        const std::array<double, JoinDepthTrial::kCandidates.size()>& seconds, uint64_t seed = 1,
+                        const std::array<double, JoinDepthTrial::kCandidates.size()>& rays, uint64_t seed = 1,
                         const std::function<void(uint64_t, int, int, Film&)>& alter = {}) {
   JoinDepthTrial trial(kSize, kSize);
   Film before(kSize, kSize);
@@ -35,7 +35,7 @@ JoinDepthTrial runTrial(float mean, const std::function<float(size_t, Rng&)>& sa
     for (int y = 0; y < kSize; ++y)
       for (int x = 0; x < kSize; ++x) pass.addSample(x, y, glm::vec3(sample(c, rng)));
     if (alter) alter(p, trial.depthFor(p), kSize, pass);
-    trial.record(p, pass, seconds[c]);
+    trial.record(p, pass, rays[c]);
   }
   EXPECT_TRUE(trial.decided());
   return trial;
@@ -59,7 +59,7 @@ TEST(JoinDepthTrial, TriesEachCandidateInTurnThenKeepsTheWinner) {
   EXPECT_EQ(cheap.chosen(), 1);
   EXPECT_EQ(cheap.depthFor(JoinDepthTrial::kLastPass + 1), 1);
   EXPECT_EQ(cheap.depthFor(1000), 1);
-  // The scores: the variance of a uniform of half-width w is w^2 / 3, over (1 + 0.01) times seconds.
+  // The scores: the variance of a uniform of half-width w is w^2 / 3, over (1 + 0.01) times rays.
   EXPECT_NEAR(cheap.scores()[0], 0.16 / 3.0 / 1.01 * 1.0, 0.02);
   EXPECT_NEAR(cheap.scores()[1], 0.04 / 3.0 / 1.01 * 1.5, 0.006);
   const JoinDepthTrial dear = runTrial(1.0f, uniformAround1({0.4f, 0.2f}), {1.0, 5.0});
@@ -113,27 +113,27 @@ TEST(JoinDepthTrial, KeepsEveryVertexWithoutAStart) {
 }
 
 // The render loops' side (render_job, progressive_session): each pass joins to the depth of its slot,
-// trial passes render into a film of their own whose samples still reach the image, and the last
-// complete trial pass decides. As in the viewer, the first trial pass is cut short (a mode switch) and
-// run again: its samples count in the image, but neither its seconds nor its variance nor the pixel
-// weights (set when the pass before the trial completes) may see them.
+// trial passes render into a film of their own whose samples still reach the image, weighing half as
+// much as the others', and the last complete trial pass decides. As in the viewer, the first trial
+// pass is cut short (a mode switch) and run again: its samples count in the image, but neither its
+// rays nor its variance nor the pixel weights (set when the pass before the trial completes) may see them.
 TEST(JoinDepthTrial, PassesRouteTrialSamplesToTheirOwnFilmAndIntoTheImage) {
   static_assert(JoinDepthTrial::kFirstPass == 4 && JoinDepthTrial::kLastPass == 7);
   JoinDepthTrial trial(2, 1);
   LightVertexCache joins{ConnectionSettings{}};
   Film image(2, 1);
-  double sum = 0.0;
-  int count = 0;
-  const auto runPass = [&](uint64_t slot, float value, bool complete, double seconds) {
+  double sum = 0.0, weights = 0.0;
+  const auto runPass = [&](uint64_t slot, float value, bool complete, double rays) {
     joins.setJoinDepth(7);
     Film& target = trial.beginPass(slot, image, joins);
     EXPECT_EQ(joins.joinDepth(), trial.depthFor(slot)) << slot;
     EXPECT_EQ(&target == &image, !JoinDepthTrial::isTrialPass(slot)) << slot;
     target.addSample(0, 0, glm::vec3(value));
     target.addSample(1, 0, glm::vec3(value));
-    trial.endPass(slot, image, complete, seconds);
-    sum += value, ++count;
-    EXPECT_NEAR(image.resolve().pixels[0].x, sum / count, 1e-4) << slot;
+    trial.endPass(slot, image, complete, rays);
+    const double weight = JoinDepthTrial::isTrialPass(slot) ? 0.5 : 1.0;
+    sum += weight * value, weights += weight;
+    EXPECT_NEAR(image.resolve().pixels[0].x, sum / weights, 1e-4) << slot;
     EXPECT_EQ(trial.decided(), slot >= JoinDepthTrial::kLastPass) << slot;
   };
   for (uint64_t slot = 0; slot < JoinDepthTrial::kFirstPass; ++slot) runPass(slot, float(slot + 1), true, 0.5);
@@ -144,7 +144,7 @@ TEST(JoinDepthTrial, PassesRouteTrialSamplesToTheirOwnFilmAndIntoTheImage) {
     runPass(slot, slot <= JoinDepthTrial::kLastPass ? values[slot - 4] : 4.0f, true, 0.5);
   EXPECT_EQ(trial.chosen(), 1);
   EXPECT_EQ(joins.joinDepth(), 1);
-  // Variance (5 - 1)^2 / 2 = 8, weight 1 / (2.5^2 + 0.01) from the mean of the passes 1 ... 4, 0.5 s per pass.
+  // Variance (5 - 1)^2 / 2 = 8, weight 1 / (2.5^2 + 0.01) from the mean of the passes 1 ... 4, 0.5 rays per pass.
   EXPECT_NEAR(trial.scores()[0], 8.0 / 6.26 * 0.5, 1e-6);
   EXPECT_NEAR(trial.scores()[1], 0.5 / 6.26 * 0.5, 1e-6);
 }

@@ -2,7 +2,9 @@
 #include <cmath>
 #include "render/core/error.h"
 #include "render/film/image_metrics.h"
+#include "render/session/join_depth_trial.h"
 #include "render/session/render_job.h"
+#include <tbb/global_control.h>
 #include "tests/unit/support.h"
 
 namespace vpl {
@@ -76,6 +78,32 @@ TEST(RenderJob, RandomSamplerConvergesToTheStratifiedImage) {
     const glm::dvec3 a = meanRgb(random), b = meanRgb(stratified);
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c] / b[c], 1.0, 0.02) << "channel " << c;
   }
+}
+
+// `--join-depth auto` decides from the rays its trial passes traced, not their seconds, so that its
+// choice, and so the image, is the same for the same seed on any machine and thread count.
+TEST(RenderJob, JoinDepthAutoChoosesTheSameForAnyThreadCount) {
+  RenderJobSettings s = small(test::sourceDir() + "/scenes/two_rooms.gltf");
+  s.mode = SamplingMode::Mis;
+  s.width = 40;
+  s.height = 30;
+  s.spp = int(JoinDepthTrial::kLastPass) + 3;
+  s.connections.joinDepth = ConnectionSettings::kJoinDepthAuto;
+  RenderJobResult one, two;
+  {
+    tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
+    one = runRenderJob(s);
+  }
+  {
+    tbb::global_control c(tbb::global_control::max_allowed_parallelism, 2);
+    two = runRenderJob(s);
+  }
+  ASSERT_TRUE(one.joinDepthChosen.has_value());
+  ASSERT_TRUE(two.joinDepthChosen.has_value());
+  EXPECT_EQ(*one.joinDepthChosen, *two.joinDepthChosen);
+  EXPECT_EQ(one.joinDepthScores, two.joinDepthScores);
+  ASSERT_EQ(one.image.pixels.size(), two.image.pixels.size());
+  for (size_t i = 0; i < one.image.pixels.size(); ++i) ASSERT_EQ(one.image.pixels[i], two.image.pixels[i]) << "pixel " << i;
 }
 
 TEST(RenderJob, BadSettingsAreInputErrors) {
