@@ -10,6 +10,10 @@ constexpr auto kRelaxed = std::memory_order_relaxed;
 void addTo(std::atomic<double>& a, double v) { a.store(a.load(kRelaxed) + v, kRelaxed); }
 }  // namespace
 
+double Film::meanLuminance(const Pixel& p, double w) {
+  return luminance(glm::vec3(float(p.r.load(kRelaxed)), float(p.g.load(kRelaxed)), float(p.b.load(kRelaxed)))) / w;
+}
+
 Film::Film(int width, int height)
     : width_(width), height_(height), pixels_(std::make_unique<Pixel[]>(size_t(width) * size_t(height))) {}
 
@@ -54,7 +58,7 @@ Image Film::resolve() const {
   for (size_t i = 0; i < image.pixels.size(); ++i) {
     const Pixel& p = pixels_[i];
     const double w = p.weight.load(kRelaxed);
-    if (p.count.load(kRelaxed) == 0 || !(w > 0.0)) continue;
+    if (!(w > 0.0)) continue;  // no samples (or only weightless ones)
     const double inv = 1.0 / w;
     image.pixels[i] = glm::vec3(float(p.r.load(kRelaxed) * inv), float(p.g.load(kRelaxed) * inv), float(p.b.load(kRelaxed) * inv));
   }
@@ -68,7 +72,7 @@ Image Film::resolveVariance() const {
     const uint32_t n = p.count.load(kRelaxed);
     const double w = p.weight.load(kRelaxed);
     if (n < 2 || !(w > 0.0)) continue;
-    const double mean = luminance(glm::vec3(float(p.r.load(kRelaxed)), float(p.g.load(kRelaxed)), float(p.b.load(kRelaxed)))) / w;
+    const double mean = meanLuminance(p, w);
     const double var = std::max(0.0, (p.lum2.load(kRelaxed) / w - mean * mean) * n / (n - 1));
     image.pixels[i] = glm::vec3(float(var / n / (mean * mean + 1e-4)));
   }
@@ -82,7 +86,7 @@ double Film::sampleRelativeVariance() const {
     const uint32_t count = p.count.load(kRelaxed);
     const double w = p.weight.load(kRelaxed);
     if (count < 2 || !(w > 0.0)) continue;
-    const double mean = luminance(glm::vec3(float(p.r.load(kRelaxed)), float(p.g.load(kRelaxed)), float(p.b.load(kRelaxed)))) / w;
+    const double mean = meanLuminance(p, w);
     variance += std::max(0.0, (p.lum2.load(kRelaxed) / w - mean * mean) * count / (count - 1));
     mean2 += mean * mean;
   }

@@ -39,6 +39,8 @@ class Film {
     std::atomic<double> r{0}, g{0}, b{0}, lum2{0}, weight{0};
     std::atomic<uint32_t> count{0};
   };
+  // The luminance of a pixel's weighted mean, w its sum of weights (> 0).
+  static double meanLuminance(const Pixel& p, double w);
   int width_, height_;
   std::unique_ptr<Pixel[]> pixels_;
 };

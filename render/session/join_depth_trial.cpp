@@ -32,13 +32,13 @@ Film& JoinDepthTrial::beginPass(uint64_t slot, Film& image, LightVertexCache& jo
   return *passFilm_;
 }
 
-void JoinDepthTrial::endPass(uint64_t slot, Film& image, bool complete, double rays) {
+void JoinDepthTrial::endPass(uint64_t slot, Film& image, bool complete, double cameraRays, const LightVertexCache& joins) {
   if (slot + 1 == kFirstPass && complete) {
     start(image);
     passFilm_.emplace(image.width(), image.height());
   }
   if (!isTrialPass(slot) || !passFilm_) return;
-  if (complete) record(slot, *passFilm_, rays);
+  if (complete) record(slot, *passFilm_, cameraRays + double(joins.rays()));
   image.add(*passFilm_, kTrialPassWeight);
   if (decided_) passFilm_.reset();
 }

@@ -59,10 +59,11 @@ class JoinDepthTrial {
   // vertices are built: sets the depth the joins use and returns the film to render into, the image
   // itself or, during a prepared trial (endPass), a film of the pass's own.
   Film& beginPass(uint64_t slot, Film& image, LightVertexCache& joins);
-  // After the pass: a complete trial pass is recorded with the rays it traced (light paths included:
-  // a depth's cost is the whole pass's), and its samples join the image either way, weighing
-  // kTrialPassWeight. The complete pass before the trial prepares it (start() and the pass film).
-  void endPass(uint64_t slot, Film& image, bool complete, double rays);
+  // After the pass: a complete trial pass is recorded with the rays it traced, the camera paths'
+  // and the light paths' that `joins` built for it (a depth's cost is the whole pass's), and its
+  // samples join the image either way, weighing kTrialPassWeight. The complete pass before the trial
+  // prepares it (start() and the pass film).
+  void endPass(uint64_t slot, Film& image, bool complete, double cameraRays, const LightVertexCache& joins);
 
   // Before the first trial pass: the image so far, whose luminance weighs the pixels.
   void start(const Film& film);

@@ -377,8 +377,7 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
     const uint64_t index = mine.nextPass++;
     Film& target = mine.joinTrial ? mine.joinTrial->beginPass(slot, *mine.film, *mine.joins) : *mine.film;
     const PassStats pass = renderer->renderPass(target, index, &cancel_);
-    if (mine.joinTrial)
-      mine.joinTrial->endPass(slot, *mine.film, !cancelled(), double(pass.rays + (joinPaths > 0 ? mine.joins->rays() : 0)));
+    if (mine.joinTrial) mine.joinTrial->endPass(slot, *mine.film, !cancelled(), double(pass.rays), *mine.joins);
     if (mine.joins) {
       std::lock_guard lock(mutex_);
       stats_.joinDepth = mine.joins->joinDepth();

@@ -181,8 +181,7 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
     Film& target = joinTrial ? joinTrial->beginPass(pass, film, connectionCache) : film;
     // The first pass always completes: a budget never leaves an empty image.
     const PassStats stats = renderer->renderPass(target, pass, pass == 0 ? nullptr : &stop);
-    if (joinTrial)
-      joinTrial->endPass(pass, film, !(timed && stop.load()), double(stats.rays + (connecting ? connectionCache.rays() : 0)));
+    if (joinTrial) joinTrial->endPass(pass, film, !(timed && stop.load()), double(stats.rays), connectionCache);
     result.rays += stats.rays;
     result.samples += stats.samples;
     result.discarded += stats.discarded;

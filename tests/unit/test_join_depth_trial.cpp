@@ -130,7 +130,7 @@ TEST(JoinDepthTrial, PassesRouteTrialSamplesToTheirOwnFilmAndIntoTheImage) {
     EXPECT_EQ(&target == &image, !JoinDepthTrial::isTrialPass(slot)) << slot;
     target.addSample(0, 0, glm::vec3(value));
     target.addSample(1, 0, glm::vec3(value));
-    trial.endPass(slot, image, complete, rays);
+    trial.endPass(slot, image, complete, rays, joins);  // joins never built: no light-path rays
     const double weight = JoinDepthTrial::isTrialPass(slot) ? 0.5 : 1.0;
     sum += weight * value, weights += weight;
     EXPECT_NEAR(image.resolve().pixels[0].x, sum / weights, 1e-4) << slot;
