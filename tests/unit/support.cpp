@@ -211,7 +211,7 @@ std::string sourceDir() { return VPLVIEW_SOURCE_DIR; }
 std::string sharedDir() { return VPLVIEW_SHARED_DIR; }
 std::string builtInScene(const std::string& file) {
   const bool generated = std::filesystem::path(file).extension() == ".glb";
-  return (generated ? std::string(VPLVIEW_BINARY_DIR) : sourceDir()) + "/scenes/" + file;
+  return (std::filesystem::path(generated ? VPLVIEW_BINARY_DIR : VPLVIEW_SOURCE_DIR) / "scenes" / file).string();
 }
 
 std::string sharedScene(const std::string& relativePath) {
