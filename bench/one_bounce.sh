@@ -2,12 +2,14 @@
 # The authors' setting (Hua & Low 2015, their Figure 1): one-bounce indirect light (--max-depth 2),
 # equal spp, relMSE of `brdf`, `metropolis` and `mis` against a converged `brdf` reference of the same
 # depth. Their claim: MIS has the lowest error of the three. Issue 16 keeps it as an ablation row.
-# mis runs with their fixed BSDF probability (--bsdf-prob 0.5), not the learned default.
+# mis runs with their fixed BSDF probability (--bsdf-prob 0.5), not the learned default, and both guided
+# modes with their method alone: the VPL guide at the first vertex, no joins, no learning (GUIDED_FLAGS).
 #
 #   bench/one_bounce.sh BUILD_DIR OUT_DIR [SPP]        (default 64)
 #
 # Environment: SCENES ("door_ajar two_rooms cornell_box"), SEEDS ("1 2"), THREADS (2), REF_SPP (2048),
-# SIZE ("160 120"), ROULETTE (the roulette rule of every render; default: the program's).
+# SIZE ("160 120"), ROULETTE (the roulette rule of every render; default: the program's), GUIDED_FLAGS (the
+# guided modes' flags; default "--connect-paths 0 --guide-learning off", the paper's method; empty: vplview's defaults).
 # The reference is cached in OUT_DIR by the scene's content hash, size, spp and depth. Writes
 # OUT_DIR/one_bounce.csv and prints a Markdown table: mean relMSE over seeds, and each mode's ÷ brdf's.
 set -euo pipefail
@@ -19,6 +21,7 @@ exe=$build/vplview
 SCENES=${SCENES:-door_ajar two_rooms cornell_box}; SEEDS=${SEEDS:-1 2}; THREADS=${THREADS:-2}
 REF_SPP=${REF_SPP:-2048}; read -r W H <<<"${SIZE:-160 120}"
 rule=${ROULETTE:+--roulette $ROULETTE}
+guided=${GUIDED_FLAGS---connect-paths 0 --guide-learning off}
 [ -x "$exe" ] || { echo "one_bounce: no $exe" >&2; exit 2; }
 [[ $spp =~ ^[0-9]+$ ]] || { echo "one_bounce: '$spp' is not a sample count" >&2; exit 2; }
 mkdir -p "$out"; out=$(cd "$out" && pwd)
@@ -32,7 +35,8 @@ for name in $SCENES; do
   for seed in $SEEDS; do
     for mode in brdf metropolis mis; do
       img=$out/${name}_${mode}_seed$seed.exr
-      paper=; [ $mode = mis ] && paper="--bsdf-prob 0.5"  # the authors' fixed BSDF probability, not the learned one
+      paper=; [ $mode = brdf ] || paper=$guided
+      [ $mode = mis ] && paper+=" --bsdf-prob 0.5"  # the authors' fixed BSDF probability, not the learned one
       read -r secs < <("$exe" render "$scene" --mode $mode $paper --spp "$spp" --width $W --height $H --threads $THREADS \
                           --seed $seed --max-depth 2 $rule --out "$img" | json seconds)
       rel=$("$exe" compare "$img" "$ref" | json relmse)
