@@ -35,9 +35,9 @@ for name in $SCENES; do
   for seed in $SEEDS; do
     for mode in brdf metropolis mis; do
       img=$out/${name}_${mode}_seed$seed.exr
-      paper=; [ $mode = brdf ] || paper=$guided
-      [ $mode = mis ] && paper+=" --bsdf-prob 0.5"  # the authors' fixed BSDF probability, not the learned one
-      read -r secs < <("$exe" render "$scene" --mode $mode $paper --spp "$spp" --width $W --height $H --threads $THREADS \
+      flags=; [ $mode = brdf ] || flags=$guided
+      [ $mode = mis ] && flags+=" --bsdf-prob 0.5"  # the authors' fixed BSDF probability, not the learned one
+      read -r secs < <("$exe" render "$scene" --mode $mode $flags --spp "$spp" --width $W --height $H --threads $THREADS \
                           --seed $seed --max-depth 2 $rule --out "$img" | json seconds)
       rel=$("$exe" compare "$img" "$ref" | json relmse)
       echo "$name,$mode,$seed,$spp,$secs,$rel" | tee -a /dev/stderr >> "$csv"
