@@ -87,8 +87,7 @@ nlohmann::ordered_json summaryJson(const RenderJobSettings& s, const RenderJobRe
     j["connect_paths"] = r.connectionPaths;
     j["joins_per_vertex"] = s.connections.joinsPerVertex;
     if (s.connections.joinDepth == ConnectionSettings::kJoinDepthAuto) {
-      // The depth the trial chose (null: the render ended before it decided; its passes joined at every
-      // vertex but the trial's of depth 1).
+      // The depth the trial chose (null: the render ended before it decided; its passes joined at every vertex).
       j["join_depth"] = "auto";
       if (r.joinDepthChosen) j["join_depth_chosen"] = *r.joinDepthChosen;
       else j["join_depth_chosen"] = nullptr;

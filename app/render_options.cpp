@@ -92,8 +92,8 @@ void RenderOptions::addCommonTo(CLI::App& command) {
             "--join-depth",
             [this](const std::string& v) { connections.joinDepth = v == "auto" ? ConnectionSettings::kJoinDepthAuto : std::stoi(v); },
             "VPL connections: the deepest camera vertex that joins (0: the camera ray's hit; -1, the default: every "
-            "vertex; auto: after 4 passes, two passes of -1 and two of 1, weighing half in the image, then the one of "
-            "least variance x rays; a render of 8 passes or fewer never decides); the MIS weights "
+            "vertex; auto: passes 5 to 8 join at every vertex and are weighed as depth 1 too, then the one of least "
+            "variance x rays joins; a render of 8 passes or fewer never decides); the MIS weights "
             "leave out the joins it forbids")
       ->check(CLI::IsMember({"auto", "-1", "0", "1", "2"}));
   command.add_option("--join-roulette", connections.shadowRoulette,

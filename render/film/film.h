@@ -1,7 +1,7 @@
 // The accumulation buffer of a progressive render: per pixel, a weighted sum of radiance samples, a
 // weighted sum of squared luminance (for the relative-variance view), the sum of the weights and a
-// sample count. A sample added by addSample() weighs 1; add() can weigh a whole film's samples less
-// (`--join-depth auto`'s trial passes), and the mean is then the weighted mean.
+// sample count. A sample added by addSample() weighs 1; add() adds a whole film's samples (`--join-depth
+// auto`'s trial passes), and can weigh them less: the mean is then the weighted mean.
 //
 // Threading contract: workers call addSample() only for pixels of tiles they own (no two threads
 // write one pixel at once); any thread may call resolve() at any time. Fields are relaxed atomics,

@@ -120,16 +120,19 @@ class LightVertexCache {
   // Between passes only: the depth the next pass's camera vertices join to (-1: every vertex).
   void setJoinDepth(int depth) { joinDepth_ = clampJoinDepth(depth); }
   int joinDepth() const { return joinDepth_; }
-  // Whether a camera vertex at `depth` joins (ConnectionSettings::joinDepth).
-  bool joinsAt(int depth) const { return joinDepth_ < 0 || depth <= joinDepth_; }
+  // Whether a camera vertex at `depth` joins (ConnectionSettings::joinDepth), under this cache's
+  // depth or under `limit` (a depth the tracer weighs a counterfactual estimate for).
+  bool joinsAt(int depth) const { return joinsAt(depth, joinDepth_); }
+  static bool joinsAt(int depth, int limit) { return limit < 0 || depth <= limit; }
   // The light side's sum of a join from a camera vertex at `depth` to y, over the ways of making the
   // same path with the connection nearer the light that the depth limit allows; lightPdf: y's BSDF
   // density from the join's direction back along the light path.
-  float lightSideSum(const LightVertex& y, int depth, float lightPdf) const {
+  float lightSideSum(const LightVertex& y, int depth, float lightPdf) const { return lightSideSum(y, depth, lightPdf, joinDepth_); }
+  static float lightSideSum(const LightVertex& y, int depth, float lightPdf, int limit) {
     static_assert(ConnectionSettings::kMaxJoinDepth <= 2, "a light vertex keeps only the join two back apart");
-    if (joinDepth_ < 0) return y.dVCM + y.dVC * connectionMis(lightPdf);
-    const float oneBack = y.length == 1 || joinsAt(depth + 1) ? y.dVCM : 0.0f;
-    return oneBack + (y.dVCNotJoins + (joinsAt(depth + 2) ? y.dVCJoinTwoBack : 0.0f)) * connectionMis(lightPdf);
+    if (limit < 0) return y.dVCM + y.dVC * connectionMis(lightPdf);
+    const float oneBack = y.length == 1 || joinsAt(depth + 1, limit) ? y.dVCM : 0.0f;
+    return oneBack + (y.dVCNotJoins + (joinsAt(depth + 2, limit) ? y.dVCJoinTwoBack : 0.0f)) * connectionMis(lightPdf);
   }
   float shadowRoulette() const { return shadowRoulette_; }
   const std::vector<LightVertex>& vertices() const { return vertices_; }

@@ -91,31 +91,32 @@ struct PathTracer::Branch {
   float previousPdf = 0.0f;
   int depth = 0;
   PixelSampler sampler;
-  float dVC = 0.0f, dVCM = 0.0f;  // connections' MIS partial sums; 0 at the camera: no light tracing to it
+  MisSums mis, alt;  // connections' partial sums: the pass's join depth's and a counterfactual one's
 };
 
 float PathTracer::nextEventPdf(const glm::vec3& p, const SurfaceHit& hit) const {
   return emitterGuide_ ? emitterGuide_->pdf(p, hit) : scene_.emitters().pdfTriangle(p, hit);
 }
 
-float PathTracer::emitterHitWeight(const SurfaceHit& surface, const glm::vec3& wo, const Branch& path) const {
+float PathTracer::emitterHitWeight(const SurfaceHit& surface, const glm::vec3& wo, const Branch& path,
+                                   const MisSums& sums) const {
   if (path.depth == 0) return 1.0f;
   const EmitterSet& emitters = scene_.emitters();
   if (!connections_) return powerHeuristic(path.previousPdf, nextEventPdf(path.previousPosition, surface));
   const glm::vec3 d = surface.position - path.previousPosition;
   const float cosHit = std::abs(glm::dot(surface.geometricNormal, wo));
   const float directPdfArea = nextEventPdf(path.previousPosition, surface) * cosHit / glm::dot(d, d);
-  return bidirectionalWeight(connectionMis(directPdfArea) * path.dVCM + connectionMis(emitters.pdfEmission(surface, wo)) * path.dVC);
+  return bidirectionalWeight(connectionMis(directPdfArea) * sums.dVCM + connectionMis(emitters.pdfEmission(surface, wo)) * sums.dVC);
 }
 
 float PathTracer::nextEventWeight(const LightSample& ls, const SurfaceHit& surface, const Bsdf& bsdf, const glm::vec3& wo,
-                                  const Branch& path, ContinuationSampler& continuation) const {
+                                  const Branch& path, const MisSums& sums, ContinuationSampler& continuation) const {
   if (!connections_) return ls.delta ? 1.0f : powerHeuristic(ls.pdf, continuation.pdf(surface, bsdf, wo, ls.wi));
   // Densities of punctual lights in the solid angle of the point they sit at (Georgiev 2012).
   const float directPdf = ls.delta && std::isfinite(ls.distance) ? ls.pdf * ls.distance * ls.distance : ls.pdf;
   const float wLight = ls.delta ? 0.0f : connectionMis(cameraMisPdf(path.depth, continuation, surface, bsdf, wo, ls.wi) / directPdf);
   // The light path that starts at the sampled point and reaches here, then shifts along the camera side.
-  const float cameraSide = path.dVCM + (path.dVC > 0.0f ? path.dVC * connectionMis(bsdf.pdf(ls.wi, wo)) : 0.0f);
+  const float cameraSide = sums.dVCM + (sums.dVC > 0.0f ? sums.dVC * connectionMis(bsdf.pdf(ls.wi, wo)) : 0.0f);
   const float cosCamera = std::abs(glm::dot(surface.geometricNormal, ls.wi));
   const float wCamera = cameraSide > 0.0f ? connectionMis(ls.emissionPdf * cosCamera / (directPdf * ls.cosLight)) * cameraSide : 0.0f;
   return bidirectionalWeight(wLight + wCamera);
@@ -123,7 +124,7 @@ float PathTracer::nextEventWeight(const LightSample& ls, const SurfaceHit& surfa
 
 glm::vec3 PathTracer::unoccludedJoin(const SurfaceHit& surface, const Bsdf& bsdf, const glm::vec3& wo, const Branch& path,
                                      ContinuationSampler& continuation, const LightVertex& y, float scale,
-                                     Ray& shadow) const {
+                                     Ray& shadow, int altLimit, glm::vec3& altJoined) const {
   if (path.depth + 1 + y.length > settings_.maxDepth) return glm::vec3(0.0f);
   const glm::vec3 d = y.position - surface.position;
   const float dist2 = glm::dot(d, d);
@@ -142,21 +143,30 @@ glm::vec3 PathTracer::unoccludedJoin(const SurfaceHit& surface, const Bsdf& bsdf
   // first vertex the camera side has no other strategy (no light tracing to the camera): cameraSide
   // is 0 and its densities are not needed.
   const float cameraPdf = path.depth == 0 ? continuation.pdf(surface, bsdf, wo, w) : camera.pdf;
-  const float wLight = connectionMis(cameraPdf * cosLight / dist2) * connections_->lightSideSum(y, path.depth, light.pdf);
-  const float cameraSide = path.dVCM + (path.dVC > 0.0f ? path.dVC * connectionMis(bsdf.pdf(w, wo)) : 0.0f);
-  const float wCamera = cameraSide > 0.0f ? connectionMis(y.bsdf.pdf(y.wIn, -w) * cosCamera / dist2) * cameraSide : 0.0f;
-  // Over this join's own count (the other joins' counts are in the partial sums).
-  const float weight = bidirectionalWeight((wLight + wCamera) / connections_->misFactor(y));
+  const auto weightFor = [&](const MisSums& sums, int limit) {
+    const float wLight = connectionMis(cameraPdf * cosLight / dist2) * LightVertexCache::lightSideSum(y, path.depth, light.pdf, limit);
+    const float cameraSide = sums.dVCM + (sums.dVC > 0.0f ? sums.dVC * connectionMis(bsdf.pdf(w, wo)) : 0.0f);
+    const float wCamera = cameraSide > 0.0f ? connectionMis(y.bsdf.pdf(y.wIn, -w) * cosCamera / dist2) * cameraSide : 0.0f;
+    // Over this join's own count (the other joins' counts are in the partial sums).
+    return bidirectionalWeight((wLight + wCamera) / connections_->misFactor(y));
+  };
+  const float weight = weightFor(path.mis, connections_->joinDepth());
   if (!(weight > 0.0f)) return glm::vec3(0.0f);
   shadow = spawnShadowRay(surface, w, dist);
+  if (altLimit != kNoCounterfactual && LightVertexCache::joinsAt(path.depth, altLimit))
+    altJoined = camera.f * light.f * y.alpha * (cosLight / dist2 * scale * weightFor(path.alt, altLimit));
   return camera.f * light.f * y.alpha * (cosLight / dist2 * scale * weight);
 }
 
 glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, ContinuationSampler& continuation,
-                               PathStats& stats, uint64_t pixel) const {
+                               PathStats& stats, uint64_t pixel, JoinDepthCounterfactual* counterfactual) const {
   const EmitterSet& emitters = scene_.emitters();
   continuation.beginPath(pixel);
   glm::vec3 L(0.0f);
+  // The counterfactual join depth's estimate, weighed alongside when this pass joins at every vertex.
+  const bool alt = counterfactual && connections_ && connections_->joinDepth() < 0;
+  const int altLimit = alt ? counterfactual->depth : kNoCounterfactual;
+  glm::vec3 altL(0.0f);
   // The branches still to trace (kept per thread: most samples never split); `path` is being traced.
   static thread_local std::vector<Branch> pending;
   pending.clear();
@@ -165,7 +175,7 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
   float pixelEstimate = 0.0f;  // the weight window's reference, set at the camera ray's hit
   glm::vec3 firstContinuationStart(0.0f);  // L before the first vertex's continuation
 
-  Branch path{cameraRay, glm::vec3(1.0f), glm::vec3(0.0f), 0.0f, 0, sampler};
+  Branch path{cameraRay, glm::vec3(1.0f), glm::vec3(0.0f), 0.0f, 0, sampler, {}, {}};
   for (;;) {
     Ray& ray = path.ray;
     glm::vec3& beta = path.beta;
@@ -196,20 +206,30 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
       if (connections_) {
         const float cosHit = std::abs(glm::dot(surface.geometricNormal, wo));
         if (!(cosHit > 0.0f)) break;
-        path.dVCM *= connectionMis(hit.t * hit.t) / connectionMis(cosHit);
-        path.dVC /= connectionMis(cosHit);
+        const float grow = connectionMis(hit.t * hit.t) / connectionMis(cosHit), shrink = connectionMis(cosHit);
+        path.mis.dVCM *= grow;
+        path.mis.dVC /= shrink;
+        if (alt) {
+          path.alt.dVCM *= grow;
+          path.alt.dVC /= shrink;
+        }
       }
 
       // Emitter hit, weighted against next-event estimation of the same triangle (and, with
       // connections, against every join that makes the same path).
       const glm::vec3 le = emitters.emitted(surface, wo);
       if (!isBlack(le)) {
-        L += beta * le * emitterHitWeight(surface, wo, path);
+        L += beta * le * emitterHitWeight(surface, wo, path, path.mis);
+        if (alt) altL += beta * le * emitterHitWeight(surface, wo, path, path.alt);
       }
       // From here on dVCM stands for a join with its light end at this vertex (for the emitter hit
       // above, next-event estimation's sample of it), which counts as the cache's factor of joins.
       // (A join from the vertex before this one, at depth - 1, which a join depth limit may forbid.)
-      if (connections_) path.dVCM *= connections_->joinsAt(depth - 1) ? connections_->misFactor(surface.position) : 0.0f;
+      if (connections_) {
+        const float factor = connections_->misFactor(surface.position);
+        path.mis.dVCM *= connections_->joinsAt(depth - 1) ? factor : 0.0f;
+        if (alt) path.alt.dVCM *= LightVertexCache::joinsAt(depth - 1, altLimit) ? factor : 0.0f;
+      }
       if (depth + 1 > settings_.maxDepth) break;
 
       const Bsdf bsdf = scene_.bsdf(surface, wo);
@@ -260,8 +280,9 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
           if (emitterGuide_) emitterGuide_->attempted(ls->guideSlot);
           if (!scene_.accel().occluded(spawnShadowRay(surface, ls->wi, ls->distance))) {
             if (emitterGuide_) emitterGuide_->arrived(ls->guideSlot, luminance(ls->radiance) * cosReceiver / ls->pdf);
-            const float w = nextEventWeight(*ls, surface, bsdf, wo, path, continuation);
+            const float w = nextEventWeight(*ls, surface, bsdf, wo, path, path.mis, continuation);
             L += beta * f * ls->radiance * (w / ls->pdf);
+            if (alt) altL += beta * f * ls->radiance * (nextEventWeight(*ls, surface, bsdf, wo, path, path.alt, continuation) / ls->pdf);
           }
         }
       }
@@ -270,7 +291,9 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
       for (int j = 0; j < joins; ++j) {
         const LightVertex& y = *joinTo[size_t(j)];
         Ray shadow;
-        glm::vec3 joined = beta * unoccludedJoin(surface, bsdf, wo, path, continuation, y, joinScale[size_t(j)], shadow);
+        glm::vec3 altJoined(0.0f);
+        glm::vec3 joined = beta * unoccludedJoin(surface, bsdf, wo, path, continuation, y, joinScale[size_t(j)], shadow,
+                                                 altLimit, altJoined);
         if (isBlack(joined)) continue;
         // Shadow-ray roulette: a join worth little against what the sample holds already rarely pays its ray.
         if (const float share = connections_->shadowRoulette(); share > 0.0f) {
@@ -279,12 +302,15 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
             const float survival = std::max(c / threshold, ConnectionSettings::kMinShadowSurvival);
             if (u.random().uniform() >= survival) continue;
             joined /= survival;
+            altJoined /= survival;
           }
         }
         ++stats.rays;
+        if (alt && !LightVertexCache::joinsAt(depth, altLimit)) ++stats.raysPastCounterfactual;
         if (scene_.accel().occluded(shadow)) continue;
         connections_->record(y, luminance(joined));
         L += joined;
+        if (alt) altL += beta * altJoined;
       }
 
       if (depth == 0) firstContinuationStart = L;
@@ -292,14 +318,15 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
       // The split's other branches first (each its own numbers), then this path's own continuation.
       const glm::vec3 branchBeta = beta / float(split);
       for (int b = 1; b < split; ++b) {
-        Branch next{Ray{}, glm::vec3(0.0f), surface.position, 0.0f, depth + 1, path.sampler.branch(nextBranchId++), path.dVC, path.dVCM};
+        Branch next{Ray{}, glm::vec3(0.0f), surface.position, 0.0f, depth + 1, path.sampler.branch(nextBranchId++), path.mis, path.alt};
         VertexSamples ub(next.sampler, depth);
         DirectionSample dir;
         glm::vec3 weight;
         if (!sampleContinuation(surface, bsdf, wo, ub, continuation, stats, dir, weight)) continue;
         next.beta = branchBeta * weight;
         if (!isFiniteNonNegative(next.beta)) continue;
-        if (connections_) advanceConnectionMis(next.dVC, next.dVCM, depth, surface, bsdf, wo, dir);
+        if (connections_) advanceConnectionMis(next.mis.dVC, next.mis.dVCM, depth, surface, bsdf, wo, dir);
+        if (alt) advanceConnectionMis(next.alt.dVC, next.alt.dVCM, depth, surface, bsdf, wo, dir);
         next.ray = spawnRay(surface, dir.wi);
         next.previousPdf = dir.pdf;
         pending.push_back(next);
@@ -322,7 +349,8 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
         if (u.roulette() >= survive) break;
         beta /= survive;
       }
-      if (connections_) advanceConnectionMis(path.dVC, path.dVCM, depth, surface, bsdf, wo, next);
+      if (connections_) advanceConnectionMis(path.mis.dVC, path.mis.dVCM, depth, surface, bsdf, wo, next);
+      if (alt) advanceConnectionMis(path.alt.dVC, path.alt.dVCM, depth, surface, bsdf, wo, next);
       path.previousPosition = surface.position;
       path.previousPdf = next.pdf;
       ray = spawnRay(surface, next.wi);
@@ -335,6 +363,7 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
     pending.pop_back();
   }
   continuation.endPath(L - firstContinuationStart);
+  if (counterfactual) counterfactual->L = alt ? altL : L;
   return L;
 }
 

@@ -46,6 +46,18 @@ struct PathStats {
   uint64_t guideSamples = 0;  // continuation directions drawn from the guide
   uint64_t proposals = 0, accepted = 0;  // Metropolis mutations
   uint64_t branches = 0;      // extra paths grown by splitting (the vpl roulette rule)
+  uint64_t raysPastCounterfactual = 0;  // shadow rays of joins that a counterfactual depth forbids
+};
+
+// What a camera sample would have brought back had its joins stopped at camera depth `depth`, weighed
+// on the same paths as the sample itself (which joins at every vertex): `--join-depth auto` compares
+// both estimators on the same passes instead of spending passes on the one that loses. Joins only
+// change the weights and add shadow rays, never the camera path, so this is exactly the estimate a
+// pass at that depth would have made from the same numbers (the rays it would not have traced are
+// counted in PathStats::raysPastCounterfactual).
+struct JoinDepthCounterfactual {
+  int depth = 1;
+  glm::vec3 L{0.0f};  // set by PathTracer::radiance: the sample's own when it has no joins to weigh
 };
 
 // How a vertex picks its continuation direction. The BSDF strategy is the reference; guided
@@ -104,8 +116,10 @@ class PathTracer {
 
   // Radiance arriving along the camera ray, every decision drawn from its dimension of `sampler`.
   // May be non-finite only through a bug; callers check.
+  // `counterfactual`: also weigh the sample as joins up to its depth would (only when this pass joins
+  // at every vertex; otherwise it gets the sample's own radiance).
   glm::vec3 radiance(const Ray& cameraRay, PixelSampler& sampler, ContinuationSampler& continuation, PathStats& stats,
-                     uint64_t pixel = 0) const;
+                     uint64_t pixel = 0, JoinDepthCounterfactual* counterfactual = nullptr) const;
   // The same with independent random numbers from `rng` (benches that trace paths of their own).
   glm::vec3 radiance(const Ray& cameraRay, Rng& rng, ContinuationSampler& continuation, PathStats& stats,
                      uint64_t pixel = 0) const {
@@ -117,19 +131,28 @@ class PathTracer {
 
  private:
   struct Branch;
+  // The camera side's MIS partial sums of connections (Georgiev 2012).
+  struct MisSums {
+    float dVC = 0.0f, dVCM = 0.0f;  // 0 at the camera: no light tracing to it
+  };
+  static constexpr int kNoCounterfactual = -100;  // a join depth limit that stands for none
   // Radiance reflected at a vertex towards the path, as the VPLs predict it (luminance).
   float predictedRadiance(const SurfaceHit& surface, const Bsdf& bsdf) const;
   // MIS weights of an emitter hit and of a next-event sample: against each other alone, or with
   // connections against every join that makes the same path.
   // Next-event estimation's solid-angle density at p of an emitter hit's point.
   float nextEventPdf(const glm::vec3& p, const SurfaceHit& hit) const;
-  float emitterHitWeight(const SurfaceHit& surface, const glm::vec3& wo, const Branch& path) const;
+  // `sums`: the path's own, or those of a counterfactual join depth.
+  float emitterHitWeight(const SurfaceHit& surface, const glm::vec3& wo, const Branch& path, const MisSums& sums) const;
   float nextEventWeight(const LightSample& ls, const SurfaceHit& surface, const Bsdf& bsdf, const glm::vec3& wo,
-                        const Branch& path, ContinuationSampler& continuation) const;
+                        const Branch& path, const MisSums& sums, ContinuationSampler& continuation) const;
   // The MIS-weighted contribution of joining camera vertex `surface` to light vertex y, picked with
   // weight `scale` (without the path's throughput), if `shadow` arrives; 0 when y is too long or faces away.
+  // With a counterfactual depth (`altLimit`), `altJoined` is the same join weighed for it (0 where it
+  // forbids the join, or where the join's own weight is 0 and so no ray is traced).
   glm::vec3 unoccludedJoin(const SurfaceHit& surface, const Bsdf& bsdf, const glm::vec3& wo, const Branch& path,
-                           ContinuationSampler& continuation, const LightVertex& y, float scale, Ray& shadow) const;
+                           ContinuationSampler& continuation, const LightVertex& y, float scale, Ray& shadow,
+                           int altLimit, glm::vec3& altJoined) const;
 
   const RenderScene& scene_;
   PathTracerSettings settings_;

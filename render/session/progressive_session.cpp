@@ -375,9 +375,10 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
     if (joinPaths > 0) mine.joins->build(scene, settings_.seed, mine.nextPass, joinPaths, settings_.tracer.maxDepth - 1,
                                       settings_.stratifiedSampler, lights);
     const uint64_t index = mine.nextPass++;
-    Film& target = mine.joinTrial ? mine.joinTrial->beginPass(slot, *mine.film, *mine.joins) : *mine.film;
-    const PassStats pass = renderer->renderPass(target, index, &cancel_);
-    if (mine.joinTrial) mine.joinTrial->endPass(slot, *mine.film, !cancelled(), double(pass.rays), *mine.joins);
+    const JoinDepthTrial::PassTargets target = mine.joinTrial ? mine.joinTrial->beginPass(slot, *mine.film, *mine.joins)
+                                                             : JoinDepthTrial::PassTargets{*mine.film};
+    const PassStats pass = renderer->renderPass(target.film, index, &cancel_, target.counterfactual, target.counterfactualDepth);
+    if (mine.joinTrial) mine.joinTrial->endPass(slot, *mine.film, !cancelled(), pass, *mine.joins);
     if (mine.joins) {
       std::lock_guard lock(mutex_);
       stats_.joinDepth = mine.joins->joinDepth();

@@ -157,7 +157,7 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
   const bool autoRoulette = settings.tracer.roulette == RouletteRule::Auto && settings.mode != SamplingMode::Preview;
   WindowSwitch window;
 
-  // --join-depth auto: a few passes of each candidate depth, each into a film of its own.
+  // --join-depth auto: a few passes weighed for each candidate depth.
   std::optional<JoinDepthTrial> joinTrial;
   if (connecting && settings.connections.joinDepth == ConnectionSettings::kJoinDepthAuto)
     joinTrial.emplace(settings.width, settings.height);
@@ -178,10 +178,12 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
       result.timings.connections += secondsSince(t);
       result.rays += connectionCache.rays();
     }
-    Film& target = joinTrial ? joinTrial->beginPass(pass, film, connectionCache) : film;
+    const JoinDepthTrial::PassTargets target = joinTrial ? joinTrial->beginPass(pass, film, connectionCache)
+                                                        : JoinDepthTrial::PassTargets{film};
     // The first pass always completes: a budget never leaves an empty image.
-    const PassStats stats = renderer->renderPass(target, pass, pass == 0 ? nullptr : &stop);
-    if (joinTrial) joinTrial->endPass(pass, film, !(timed && stop.load()), double(stats.rays), connectionCache);
+    const PassStats stats = renderer->renderPass(target.film, pass, pass == 0 ? nullptr : &stop, target.counterfactual,
+                                                 target.counterfactualDepth);
+    if (joinTrial) joinTrial->endPass(pass, film, !(timed && stop.load()), stats, connectionCache);
     result.rays += stats.rays;
     result.samples += stats.samples;
     result.discarded += stats.discarded;

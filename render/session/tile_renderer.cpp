@@ -11,8 +11,9 @@ PixelShaderFactory pathTracerShader(const PathTracer& tracer, ContinuationFactor
   if (!continuation) continuation = [](uint32_t, uint64_t) { return std::make_unique<BsdfContinuation>(); };
   return [&tracer, continuation](uint32_t tile, uint64_t pass) -> PixelShader {
     std::shared_ptr<ContinuationSampler> strategy = continuation(tile, pass);
-    return [&tracer, strategy](const Ray& ray, uint64_t pixel, PixelSampler& sampler, PathStats& stats) {
-      return tracer.radiance(ray, sampler, *strategy, stats, pixel);
+    return [&tracer, strategy](const Ray& ray, uint64_t pixel, PixelSampler& sampler, PathStats& stats,
+                               JoinDepthCounterfactual* counterfactual) {
+      return tracer.radiance(ray, sampler, *strategy, stats, pixel, counterfactual);
     };
   };
 }
@@ -27,7 +28,8 @@ TileRenderer::TileRenderer(const Camera& camera, uint64_t seed, PixelShaderFacto
     : camera_(camera), seed_(seed), shader_(std::move(shader)), stratified_(stratified),
       tilesX_((camera.width() + kTileSize - 1) / kTileSize), tilesY_((camera.height() + kTileSize - 1) / kTileSize) {}
 
-PassStats TileRenderer::renderPass(Film& film, uint64_t pass, const std::atomic<bool>* stop) const {
+PassStats TileRenderer::renderPass(Film& film, uint64_t pass, const std::atomic<bool>* stop, Film* counterfactual,
+                                   int counterfactualDepth) const {
   tbb::combinable<PassStats> perThread;
   const int width = camera_.width(), height = camera_.height();
   tbb::parallel_for(0, tileCount(), [&](int tile) {
@@ -42,13 +44,17 @@ PassStats TileRenderer::renderPass(Film& film, uint64_t pass, const std::atomic<
         const uint64_t pixel = uint64_t(y) * uint64_t(width) + uint64_t(x);
         PixelSampler sampler(seed_, pixel, pass, stratified_);
         const Ray ray = camera_.generateRay(glm::vec2(float(x), float(y)) + sampler.cameraJitter());
-        const glm::vec3 L = shade(ray, pixel, sampler, path);
+        JoinDepthCounterfactual alternative{counterfactualDepth};
+        // Set to the sample's own by any shader that does not weigh one.
+        alternative.L = glm::vec3(-1.0f);
+        const glm::vec3 L = shade(ray, pixel, sampler, path, counterfactual ? &alternative : nullptr);
         ++stats.samples;
         if (!isFiniteNonNegative(L)) {
           ++stats.discarded;
           continue;
         }
         film.addSample(x, y, L);
+        if (counterfactual) counterfactual->addSample(x, y, isFiniteNonNegative(alternative.L) ? alternative.L : L);
       }
     stats.rays += path.rays;
     stats.bsdfSamples += path.bsdfSamples;
@@ -56,6 +62,7 @@ PassStats TileRenderer::renderPass(Film& film, uint64_t pass, const std::atomic<
     stats.proposals += path.proposals;
     stats.accepted += path.accepted;
     stats.branches += path.branches;
+    stats.raysPastCounterfactual += path.raysPastCounterfactual;
   });
   PassStats total;
   perThread.combine_each([&](const PassStats& s) { total += s; });

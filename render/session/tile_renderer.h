@@ -24,16 +24,20 @@ struct PassStats {
   uint64_t bsdfSamples = 0, guideSamples = 0;
   uint64_t proposals = 0, accepted = 0;
   uint64_t branches = 0;
+  uint64_t raysPastCounterfactual = 0;  // of `rays`: those a counterfactual join depth would not trace
   PassStats& operator+=(const PassStats& o) {
     rays += o.rays; samples += o.samples; discarded += o.discarded;
     bsdfSamples += o.bsdfSamples; guideSamples += o.guideSamples;
     proposals += o.proposals; accepted += o.accepted; branches += o.branches;
+    raysPastCounterfactual += o.raysPastCounterfactual;
     return *this;
   }
 };
 
-// Radiance along one camera ray of pixel `pixel` (row-major index).
-using PixelShader = std::function<glm::vec3(const Ray& ray, uint64_t pixel, PixelSampler& sampler, PathStats& stats)>;
+// Radiance along one camera ray of pixel `pixel` (row-major index); a shader that joins light vertices
+// also fills `counterfactual`, when given, and others leave it alone.
+using PixelShader = std::function<glm::vec3(const Ray& ray, uint64_t pixel, PixelSampler& sampler, PathStats& stats,
+                                            JoinDepthCounterfactual* counterfactual)>;
 // Makes the shader of one tile and pass. Each tile gets its own, so per-tile state (such as Markov
 // chains) is deterministic and never shared between threads.
 using PixelShaderFactory = std::function<PixelShader(uint32_t tileIndex, uint64_t pass)>;
@@ -53,7 +57,10 @@ class TileRenderer {
   TileRenderer(const Camera& camera, uint64_t seed, PixelShaderFactory shader, bool stratified = true);
 
   // Adds one sample per pixel to film. Stops early (between tiles) when *stop becomes true.
-  PassStats renderPass(Film& film, uint64_t pass, const std::atomic<bool>* stop = nullptr) const;
+  // `counterfactual`: also adds to it what each sample would have been with joins only up to camera
+  // depth `counterfactualDepth` (PathTracer::radiance), for `--join-depth auto`.
+  PassStats renderPass(Film& film, uint64_t pass, const std::atomic<bool>* stop = nullptr, Film* counterfactual = nullptr,
+                       int counterfactualDepth = 1) const;
 
   int tileCount() const { return tilesX_ * tilesY_; }
   static int tileCountFor(int width, int height) {

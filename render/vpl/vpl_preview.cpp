@@ -203,7 +203,8 @@ PixelShaderFactory previewShader(const RenderScene& scene, const VplField& field
   const int m = settings.clustersPerPass;
   const float pixelShare = settings.pixelChoiceShare;
   return [&scene, &field, m, pixelShare](uint32_t, uint64_t) -> PixelShader {
-    return [&scene, &field, m, pixelShare](const Ray& ray, uint64_t pixel, PixelSampler& sampler, PathStats& stats) -> glm::vec3 {
+    return [&scene, &field, m, pixelShare](const Ray& ray, uint64_t pixel, PixelSampler& sampler, PathStats& stats,
+                                                   JoinDepthCounterfactual*) -> glm::vec3 {
       const EmitterSet& emitters = scene.emitters();
       const RayHit hit = scene.accel().intersect(ray);
       ++stats.rays;

@@ -1,6 +1,6 @@
 // The film's accumulation (render/film/film.h): another film's samples added at weight 1 are the
 // same as adding them here, and at weight w each counts w times a sample of its own, in the mean and
-// in the variance's moments alike (`--join-depth auto` weighs its trial passes so).
+// in the variance's moments alike (`--join-depth auto` adds its trial passes so, at weight 1).
 #include <gtest/gtest.h>
 #include "render/film/film.h"
 

@@ -1,21 +1,24 @@
 // `--join-depth auto`'s decision (render/session/join_depth_trial.h): the candidate of least variance
 // x rays wins, a single bright sample does not decide, and the pixels are weighed by the image before
 // the trial. That every depth, and so every mix of them, keeps the image unbiased is checked pixel
-// by pixel against brdf (test_guided_modes, cornell_box_mis_join_depth_auto) and by the furnace.
+// by pixel against brdf (test_guided_modes, cornell_box_mis_join_depth_auto) and by the furnace; that
+// the tracer's counterfactual estimate is depth 1's own, in test_path_tracer.
 #include <functional>
+#include <utility>
 #include <gtest/gtest.h>
 #include "render/film/film.h"
 #include "render/integrator/light_vertex_cache.h"
 #include "render/sampling/rng.h"
 #include "render/session/join_depth_trial.h"
+#include "render/session/tile_renderer.h"
 
 namespace vpl {
 namespace {
 
 constexpr int kSize = 36;
 
-// Runs a whole trial: the image so far is `mean` everywhere, and each trial pass of candidate c
-// draws every pixel from sample(c, rng), tracing rays[c].
+// Runs a whole trial: the image so far is `mean` everywhere, and each trial pass draws every pixel of
+// candidate c's film from sample(c, rng), which traces rays[c].
 JoinDepthTrial runTrial(float mean, const std::function<float(size_t, Rng&)>& sample,
                         const std::array<double, JoinDepthTrial::kCandidates.size()>& rays, uint64_t seed = 1,
                         const std::function<void(uint64_t, int, int, Film&)>& alter = {}) {
@@ -25,20 +28,37 @@ JoinDepthTrial runTrial(float mean, const std::function<float(size_t, Rng&)>& sa
     for (int x = 0; x < kSize; ++x) before.addSample(x, y, glm::vec3(mean));
   trial.start(before);
   Rng rng(seed);
-  Film pass(kSize, kSize);
+  std::array<Film, JoinDepthTrial::kCandidates.size()> films{Film(kSize, kSize), Film(kSize, kSize)};
   for (uint64_t p = JoinDepthTrial::kFirstPass; p <= JoinDepthTrial::kLastPass; ++p) {
     EXPECT_TRUE(JoinDepthTrial::isTrialPass(p));
     EXPECT_FALSE(trial.decided());
-    size_t c = 0;
-    while (JoinDepthTrial::kCandidates[c] != trial.depthFor(p)) ++c;
-    pass.clear();
-    for (int y = 0; y < kSize; ++y)
-      for (int x = 0; x < kSize; ++x) pass.addSample(x, y, glm::vec3(sample(c, rng)));
-    if (alter) alter(p, trial.depthFor(p), kSize, pass);
-    trial.record(p, pass, rays[c]);
+    EXPECT_EQ(trial.depthFor(p), -1);  // the trial's passes join at every vertex
+    for (size_t c = 0; c < films.size(); ++c) {
+      films[c].clear();
+      for (int y = 0; y < kSize; ++y)
+        for (int x = 0; x < kSize; ++x) films[c].addSample(x, y, glm::vec3(sample(c, rng)));
+      if (alter) alter(p, JoinDepthTrial::kCandidates[c], kSize, films[c]);
+    }
+    trial.record(p, {&films[0], &films[1]}, rays);
   }
   EXPECT_TRUE(trial.decided());
   return trial;
+}
+
+// Records every trial pass, each pixel of pass p drawing (every vertex's, depth 1's) from samples(x, p).
+void recordPasses(JoinDepthTrial& trial, const std::function<std::pair<glm::vec3, glm::vec3>(int, uint64_t)>& samples) {
+  Film every(kSize, kSize), one(kSize, kSize);
+  for (uint64_t p = JoinDepthTrial::kFirstPass; p <= JoinDepthTrial::kLastPass; ++p) {
+    every.clear();
+    one.clear();
+    for (int y = 0; y < kSize; ++y)
+      for (int x = 0; x < kSize; ++x) {
+        const auto [a, b] = samples(x, p);
+        every.addSample(x, y, a);
+        one.addSample(x, y, b);
+      }
+    trial.record(p, {&every, &one}, {1.0, 1.0});
+  }
 }
 
 // Candidate c's samples: uniform around 1 with half-width spread[c].
@@ -46,13 +66,11 @@ std::function<float(size_t, Rng&)> uniformAround1(std::array<float, 2> spread) {
   return [spread](size_t c, Rng& rng) { return 1.0f + spread[c] * (2.0f * rng.uniform() - 1.0f); };
 }
 
-TEST(JoinDepthTrial, TriesEachCandidateInTurnThenKeepsTheWinner) {
+TEST(JoinDepthTrial, MeasuresBothCandidatesThenKeepsTheWinner) {
   JoinDepthTrial trial(4, 4);
   EXPECT_EQ(trial.depthFor(0), -1);  // every vertex before the trial
   EXPECT_FALSE(JoinDepthTrial::isTrialPass(JoinDepthTrial::kFirstPass - 1));
   EXPECT_FALSE(JoinDepthTrial::isTrialPass(JoinDepthTrial::kLastPass + 1));
-  for (size_t i = 0; i < JoinDepthTrial::kCandidates.size(); ++i)
-    EXPECT_EQ(trial.depthFor(JoinDepthTrial::kFirstPass + i), JoinDepthTrial::kCandidates[i]);
 
   // Candidate 1 (depth 1) has a quarter of the variance at 1.5x the time: it wins; at 5x it loses.
   const JoinDepthTrial cheap = runTrial(1.0f, uniformAround1({0.4f, 0.2f}), {1.0, 1.5});
@@ -64,15 +82,18 @@ TEST(JoinDepthTrial, TriesEachCandidateInTurnThenKeepsTheWinner) {
   EXPECT_NEAR(cheap.scores()[1], 0.04 / 3.0 / 1.01 * 1.5, 0.006);
   const JoinDepthTrial dear = runTrial(1.0f, uniformAround1({0.4f, 0.2f}), {1.0, 5.0});
   EXPECT_EQ(dear.chosen(), -1);
-  // Time alone decides between equal variances.
-  EXPECT_EQ(runTrial(1.0f, uniformAround1({0.3f, 0.3f}), {1.0, 0.9}).chosen(), 1);
+  // Between equal variances, rays decide, but depth 1 must forecast a clear gain (kForecastMargin):
+  // 0.8x every vertex's rays win, 0.95x do not.
+  static_assert(JoinDepthTrial::kForecastMargin > 0.85 && JoinDepthTrial::kForecastMargin < 0.92);
+  EXPECT_EQ(runTrial(1.0f, uniformAround1({0.3f, 0.3f}), {1.0, 0.8}).chosen(), 1);
+  EXPECT_EQ(runTrial(1.0f, uniformAround1({0.3f, 0.3f}), {1.0, 0.95}).chosen(), -1);
   EXPECT_EQ(runTrial(1.0f, uniformAround1({0.3f, 0.3f}), {0.9, 1.0}).chosen(), -1);
 }
 
 // A rare bright sample in one pixel of the best candidate's pass (a Cornell box's trial had one that
 // tripled a candidate's variance sum) does not hand the render to a worse candidate.
 TEST(JoinDepthTrial, OneBrightSampleDoesNotDecide) {
-  // Every vertex's first trial pass, with one pixel's sample replaced by 400.
+  // Every vertex's film of the first trial pass, with one pixel's sample replaced by 400.
   const auto spike = [](uint64_t pass, int depth, int size, Film& film) {
     if (pass != JoinDepthTrial::kFirstPass || depth != -1) return;
     const Image image = film.resolve();
@@ -96,57 +117,79 @@ TEST(JoinDepthTrial, WeighsPixelsByTheImageBeforeTheTrial) {
   EXPECT_NEAR(dark.scores()[0], 0.16 / 3.0 / 0.01, 2.0);
 }
 
+// Each channel counts as much as relMSE counts it, not by its share of luminance: depth 1's noise only
+// in blue (7 % of luminance), with twice the spread of every vertex's grey noise, is the worse of the two.
+TEST(JoinDepthTrial, CountsEveryChannelAsRelMseDoes) {
+  JoinDepthTrial trial(kSize, kSize);
+  Film before(kSize, kSize);
+  for (int y = 0; y < kSize; ++y)
+    for (int x = 0; x < kSize; ++x) before.addSample(x, y, glm::vec3(1.0f));
+  trial.start(before);
+  Rng rng(3);
+  recordPasses(trial, [&](int, uint64_t) {
+    const glm::vec3 every(1.0f + 0.2f * (2.0f * rng.uniform() - 1.0f));
+    return std::pair{every, glm::vec3(1.0f, 1.0f, 1.0f + 0.4f * (2.0f * rng.uniform() - 1.0f))};
+  });
+  EXPECT_EQ(trial.chosen(), -1);
+  EXPECT_NEAR(trial.scores()[1] / trial.scores()[0], 4.0 / 3.0, 0.25);
+}
+
 // Without the image before it, the trial keeps every vertex rather than guess, though depth 1's passes
 // (all alike) have no variance and every vertex's do.
 TEST(JoinDepthTrial, KeepsEveryVertexWithoutAStart) {
   JoinDepthTrial trial(kSize, kSize);
-  Film pass(kSize, kSize);
-  for (uint64_t p = JoinDepthTrial::kFirstPass; p <= JoinDepthTrial::kLastPass; ++p) {
-    pass.clear();
-    const float shift = trial.depthFor(p) == -1 ? float(p) : 0.0f;
-    for (int y = 0; y < kSize; ++y)
-      for (int x = 0; x < kSize; ++x) pass.addSample(x, y, glm::vec3(float(x % 3) + shift));
-    trial.record(p, pass, 1.0);
-  }
+  recordPasses(trial, [](int x, uint64_t p) { return std::pair{glm::vec3(float(x % 3) + float(p)), glm::vec3(float(x % 3))}; });
   EXPECT_TRUE(trial.decided());
   EXPECT_EQ(trial.chosen(), -1);
 }
 
-// The render loops' side (render_job, progressive_session): each pass joins to the depth of its slot,
-// trial passes render into a film of their own whose samples still reach the image, weighing half as
-// much as the others', and the last complete trial pass decides. As in the viewer, the first trial
-// pass is cut short (a mode switch) and run again: its samples count in the image, but neither its
-// rays nor its variance nor the pixel weights (set when the pass before the trial completes) may see them.
-TEST(JoinDepthTrial, PassesRouteTrialSamplesToTheirOwnFilmAndIntoTheImage) {
+// The render loops' side (render_job, progressive_session): every pass joins to the depth of its
+// slot (every vertex until the decision), trial passes render into a film of their own whose samples
+// reach the image at full weight and into the counterfactual's, which never does, and the last complete
+// trial pass decides from the rays each candidate traced or would have. As in the viewer, the first
+// trial pass is cut short (a mode switch) and run again: its samples count in the image, but neither
+// its rays nor its variance nor the pixel weights (set when the pass before the trial completes) may see them.
+TEST(JoinDepthTrial, PassesRouteTrialSamplesToTheirOwnFilmsAndIntoTheImage) {
   static_assert(JoinDepthTrial::kFirstPass == 4 && JoinDepthTrial::kLastPass == 7);
   JoinDepthTrial trial(2, 1);
   LightVertexCache joins{ConnectionSettings{}};
   Film image(2, 1);
-  double sum = 0.0, weights = 0.0;
-  const auto runPass = [&](uint64_t slot, float value, bool complete, double rays) {
+  double sum = 0.0;
+  int samples = 0;
+  const auto runPass = [&](uint64_t slot, float value, float counterfactual, bool complete, uint64_t rays, uint64_t past) {
     joins.setJoinDepth(7);
-    Film& target = trial.beginPass(slot, image, joins);
+    const JoinDepthTrial::PassTargets target = trial.beginPass(slot, image, joins);
     EXPECT_EQ(joins.joinDepth(), trial.depthFor(slot)) << slot;
-    EXPECT_EQ(&target == &image, !JoinDepthTrial::isTrialPass(slot)) << slot;
-    target.addSample(0, 0, glm::vec3(value));
-    target.addSample(1, 0, glm::vec3(value));
-    trial.endPass(slot, image, complete, rays, joins);  // joins never built: no light-path rays
-    const double weight = JoinDepthTrial::isTrialPass(slot) ? 0.5 : 1.0;
-    sum += weight * value, weights += weight;
-    EXPECT_NEAR(image.resolve().pixels[0].x, sum / weights, 1e-4) << slot;
+    EXPECT_EQ(joins.joinDepth(), slot <= JoinDepthTrial::kLastPass ? -1 : 1) << slot;
+    EXPECT_EQ(&target.film == &image, !JoinDepthTrial::isTrialPass(slot)) << slot;
+    EXPECT_EQ(target.counterfactual != nullptr, JoinDepthTrial::isTrialPass(slot)) << slot;
+    for (int x = 0; x < 2; ++x) {
+      target.film.addSample(x, 0, glm::vec3(value));
+      if (target.counterfactual) {
+        EXPECT_EQ(target.counterfactualDepth, 1);
+        target.counterfactual->addSample(x, 0, glm::vec3(counterfactual));
+      }
+    }
+    PassStats stats;
+    stats.rays = rays;
+    stats.raysPastCounterfactual = past;
+    trial.endPass(slot, image, complete, stats, joins);  // joins never built: no light-path rays
+    sum += value, ++samples;
+    EXPECT_NEAR(image.resolve().pixels[0].x, sum / samples, 1e-4) << slot;
     EXPECT_EQ(trial.decided(), slot >= JoinDepthTrial::kLastPass) << slot;
   };
-  for (uint64_t slot = 0; slot < JoinDepthTrial::kFirstPass; ++slot) runPass(slot, float(slot + 1), true, 0.5);
-  runPass(4, 1000.0f, false, 100.0);  // cut short
-  // Candidate -1 (slots 4 and 7) draws 1 and 5, candidate 1 (slots 5 and 6) 2 and 3.
-  const float values[] = {1.0f, 2.0f, 3.0f, 5.0f};
-  for (uint64_t slot = JoinDepthTrial::kFirstPass; slot <= JoinDepthTrial::kLastPass + 1; ++slot)
-    runPass(slot, slot <= JoinDepthTrial::kLastPass ? values[slot - 4] : 4.0f, true, 0.5);
+  for (uint64_t slot = 0; slot < JoinDepthTrial::kFirstPass; ++slot) runPass(slot, float(slot + 1), 0.0f, true, 4, 0);
+  runPass(4, 1000.0f, 1000.0f, false, 400, 0);  // cut short
+  // Every vertex draws 1, 5, 1, 5 in 4 rays a pass, depth 1 2, 3, 2, 3 in 4 - 1.
+  for (uint64_t slot = JoinDepthTrial::kFirstPass; slot <= JoinDepthTrial::kLastPass + 1; ++slot) {
+    const bool odd = slot % 2 == 1;
+    runPass(slot, slot <= JoinDepthTrial::kLastPass ? (odd ? 5.0f : 1.0f) : 4.0f, odd ? 3.0f : 2.0f, true, 4, 1);
+  }
   EXPECT_EQ(trial.chosen(), 1);
   EXPECT_EQ(joins.joinDepth(), 1);
-  // Variance (5 - 1)^2 / 2 = 8, weight 1 / (2.5^2 + 0.01) from the mean of the passes 1 ... 4, 0.5 rays per pass.
-  EXPECT_NEAR(trial.scores()[0], 8.0 / 6.26 * 0.5, 1e-6);
-  EXPECT_NEAR(trial.scores()[1], 0.5 / 6.26 * 0.5, 1e-6);
+  // Variances 16 / 3 and 1 / 3, weight 1 / (2.5^2 + 0.01) from the mean of the passes 1 ... 4.
+  EXPECT_NEAR(trial.scores()[0], 16.0 / 3.0 / 6.26 * 4.0, 1e-5);
+  EXPECT_NEAR(trial.scores()[1], 1.0 / 3.0 / 6.26 * 3.0, 1e-5);
 }
 
 }  // namespace

@@ -210,6 +210,43 @@ TEST(PathTracer, DirectLightFromAGlobeMatchesLambertsFormula) {
   }
 }
 
+// `--join-depth auto` measures depth 1 on passes that join at every vertex (JoinDepthCounterfactual):
+// the second estimate must be exactly what a pass joining up to depth 1 makes from the same numbers,
+// the rays it leaves out exactly those that pass does not trace, and the sample itself untouched.
+TEST(PathTracer, CounterfactualJoinDepthIsThatDepthsOwnPass) {
+  const RenderScene scene(test::furnaceScene(0.8f, 0.5f));
+  const Camera camera(defaultCamera(scene.data()), 24, 20);
+  PathTracerSettings settings;
+  settings.roulette = RouletteRule::Sqrt;
+  LightVertexCache connections(ConnectionSettings{.joinsPerVertex = 2});
+  const PathTracer tracer(scene, settings, nullptr, &connections);
+  const TileRenderer renderer(camera, 3, pathTracerShader(tracer));
+  for (uint64_t pass : {0u, 5u}) {
+    connections.build(scene, 3, pass, 300, settings.maxDepth - 1, true);
+    Film plain(24, 20), every(24, 20), counterfactual(24, 20), one(24, 20);
+    connections.setJoinDepth(-1);
+    const PassStats plainStats = renderer.renderPass(plain, pass);
+    const PassStats everyStats = renderer.renderPass(every, pass, nullptr, &counterfactual, 1);
+    connections.setJoinDepth(1);
+    const PassStats oneStats = renderer.renderPass(one, pass);
+    const Image a = plain.resolve(), b = every.resolve(), c = counterfactual.resolve(), d = one.resolve();
+    for (size_t i = 0; i < a.pixels.size(); ++i) {
+      ASSERT_EQ(a.pixels[i], b.pixels[i]) << "pass " << pass << " pixel " << i << ": the sample itself changed";
+      ASSERT_EQ(c.pixels[i], d.pixels[i]) << "pass " << pass << " pixel " << i;
+    }
+    EXPECT_EQ(plainStats.rays, everyStats.rays);
+    EXPECT_EQ(plainStats.raysPastCounterfactual, 0u);
+    EXPECT_GT(everyStats.raysPastCounterfactual, everyStats.rays / 10);
+    EXPECT_EQ(everyStats.rays - everyStats.raysPastCounterfactual, oneStats.rays) << "pass " << pass;
+    // A pass that already stops at depth 1 has no counterfactual to weigh: its own samples stand in.
+    Film own(24, 20), standIn(24, 20);
+    const PassStats limited = renderer.renderPass(own, pass, nullptr, &standIn, 1);
+    EXPECT_EQ(limited.raysPastCounterfactual, 0u);
+    const Image e = own.resolve(), f = standIn.resolve();
+    for (size_t i = 0; i < e.pixels.size(); ++i) ASSERT_EQ(e.pixels[i], f.pixels[i]) << "pixel " << i;
+  }
+}
+
 TEST(PathTracer, SameSeedSameImageForAnyThreadCount) {
   const RenderScene scene(test::furnaceScene(0.7f, 1.0f));
   for (const int connectPaths : {0, 700}) {  // with VPL connections, the light vertices too

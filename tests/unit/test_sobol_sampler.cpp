@@ -575,7 +575,7 @@ TEST(PixelSampler, TileRendererPassIsTheSampleIndex) {
   std::mutex mutex;
   std::vector<std::vector<glm::vec2>> jitters(size_t(kWidth) * kHeight);
   PixelShaderFactory shader = [&](uint32_t, uint64_t) -> PixelShader {
-    return [&](const Ray&, uint64_t pixel, PixelSampler& sampler, PathStats&) {
+    return [&](const Ray&, uint64_t pixel, PixelSampler& sampler, PathStats&, JoinDepthCounterfactual*) {
       const glm::vec2 j = sampler.cameraJitter();  // slots do not depend on call order: the renderer's jitter
       std::lock_guard lock(mutex);
       jitters[pixel].push_back(j);
