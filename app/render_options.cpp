@@ -91,9 +91,9 @@ void RenderOptions::addCommonTo(CLI::App& command) {
   command.add_option_function<std::string>(
             "--join-depth",
             [this](const std::string& v) { connections.joinDepth = v == "auto" ? ConnectionSettings::kJoinDepthAuto : std::stoi(v); },
-            "VPL connections: the deepest camera vertex that joins (0: the camera ray's hit; -1, the default: every "
-            "vertex; auto: passes 5 to 8 join at every vertex and are weighed as depth 1 too, then the one of least "
-            "variance x rays joins; a render of 8 passes or fewer never decides); the MIS weights "
+            "VPL connections: the deepest camera vertex that joins (0: the camera ray's hit; -1: every vertex; auto, "
+            "the default: passes 5 to 8 join at every vertex and are weighed as depth 1 too, then depth 1 joins if its "
+            "variance x rays is below 0.88 of every vertex's; a render of 8 passes or fewer never decides); the MIS weights "
             "leave out the joins it forbids")
       ->check(CLI::IsMember({"auto", "-1", "0", "1", "2"}));
   command.add_option("--join-roulette", connections.shadowRoulette,
