@@ -143,10 +143,14 @@ glm::vec3 PathTracer::unoccludedJoin(const SurfaceHit& surface, const Bsdf& bsdf
   // first vertex the camera side has no other strategy (no light tracing to the camera): cameraSide
   // is 0 and its densities are not needed.
   const float cameraPdf = path.depth == 0 ? continuation.pdf(surface, bsdf, wo, w) : camera.pdf;
+  // The reverse densities, evaluated once when either weight needs them (a counterfactual's too).
+  float reverseCamera = -1.0f, reverseLight = -1.0f;
   const auto weightFor = [&](const MisSums& sums, int limit) {
     const float wLight = connectionMis(cameraPdf * cosLight / dist2) * LightVertexCache::lightSideSum(y, path.depth, light.pdf, limit);
-    const float cameraSide = sums.dVCM + (sums.dVC > 0.0f ? sums.dVC * connectionMis(bsdf.pdf(w, wo)) : 0.0f);
-    const float wCamera = cameraSide > 0.0f ? connectionMis(y.bsdf.pdf(y.wIn, -w) * cosCamera / dist2) * cameraSide : 0.0f;
+    if (sums.dVC > 0.0f && reverseCamera < 0.0f) reverseCamera = connectionMis(bsdf.pdf(w, wo));
+    const float cameraSide = sums.dVCM + (sums.dVC > 0.0f ? sums.dVC * reverseCamera : 0.0f);
+    if (cameraSide > 0.0f && reverseLight < 0.0f) reverseLight = connectionMis(y.bsdf.pdf(y.wIn, -w) * cosCamera / dist2);
+    const float wCamera = cameraSide > 0.0f ? reverseLight * cameraSide : 0.0f;
     // Over this join's own count (the other joins' counts are in the partial sums).
     return bidirectionalWeight((wLight + wCamera) / connections_->misFactor(y));
   };
@@ -282,7 +286,8 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
             if (emitterGuide_) emitterGuide_->arrived(ls->guideSlot, luminance(ls->radiance) * cosReceiver / ls->pdf);
             const float w = nextEventWeight(*ls, surface, bsdf, wo, path, path.mis, continuation);
             L += beta * f * ls->radiance * (w / ls->pdf);
-            if (alt) altL += beta * f * ls->radiance * (nextEventWeight(*ls, surface, bsdf, wo, path, path.alt, continuation) / ls->pdf);
+            // At the camera ray's hit both depths' camera sums are 0, so the weights are the same.
+            if (alt) altL += beta * f * ls->radiance * ((depth == 0 ? w : nextEventWeight(*ls, surface, bsdf, wo, path, path.alt, continuation)) / ls->pdf);
           }
         }
       }
