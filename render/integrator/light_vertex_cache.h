@@ -128,8 +128,8 @@ class LightVertexCache {
   static bool joinsAt(int depth, int limit) { return limit < 0 || depth <= limit; }
   // The light side's sum of a join from a camera vertex at `depth` to y, over the ways of making the
   // same path with the connection nearer the light that the depth limit allows; lightPdf: y's BSDF
-  // density from the join's direction back along the light path.
-  float lightSideSum(const LightVertex& y, int depth, float lightPdf) const { return lightSideSum(y, depth, lightPdf, joinDepth_); }
+  // density from the join's direction back along the light path; limit: the join depth weighed (the
+  // pass's own, joinDepth(), or a counterfactual's; -1: every vertex).
   static float lightSideSum(const LightVertex& y, int depth, float lightPdf, int limit) {
     static_assert(ConnectionSettings::kMaxJoinDepth <= 2, "a light vertex keeps only the join two back apart");
     if (limit < 0) return y.dVCM + y.dVC * connectionMis(lightPdf);

@@ -56,9 +56,10 @@ void JoinDepthTrial::endPass(uint64_t slot, Film& image, bool complete, const Pa
 void JoinDepthTrial::record(uint64_t pass, const std::array<const Film*, kCandidates.size()>& films,
                             const std::array<double, kCandidates.size()>& rays) {
   if (!isTrialPass(pass) || decided_) return;
+  for (const Film* film : films)
+    if (size_t(film->width()) * size_t(film->height()) != pixels_) return;  // all or none of a pass
   for (size_t c = 0; c < kCandidates.size(); ++c) {
     const Image image = films[c]->resolve();
-    if (image.pixels.size() != pixels_) return;
     for (size_t i = 0; i < pixels_; ++i) {
       const glm::vec3 v = image.pixels[i];
       sum_[c][i] += v;
