@@ -85,6 +85,7 @@ nlohmann::ordered_json summaryJson(const RenderJobSettings& s, const RenderJobRe
   }
   if (r.connectionPaths > 0) {
     j["connect_paths"] = r.connectionPaths;
+    j["connect_paths_s"] = r.timings.connections;  // tracing them, all passes (inside the render phase)
     j["joins_per_vertex"] = s.connections.joinsPerVertex;
     if (s.connections.joinDepth == ConnectionSettings::kJoinDepthAuto) {
       // The depth the trial chose (null: the render ended before it decided; its passes joined at every vertex).
