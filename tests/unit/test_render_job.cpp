@@ -63,6 +63,22 @@ TEST(RenderJob, TimeBudgetIsHonouredAndGivesAtLeastOnePass) {
   EXPECT_LE(r.firstImageSeconds, r.seconds);
 }
 
+// The JSON line's connect_paths_s: the light paths of the VPL connections are traced inside the render
+// phase, every pass, and only where there are connections.
+TEST(RenderJob, LightPathSecondsArePartOfTheRenderPhase) {
+  RenderJobSettings s = small(test::sourceDir() + "/scenes/cornell_box.gltf");
+  s.mode = SamplingMode::Mis;
+  s.spp = 4;
+  const RenderJobResult joined = runRenderJob(s);
+  EXPECT_GT(joined.connectionPaths, 0);
+  EXPECT_GT(joined.timings.connections, 0.0);
+  EXPECT_LE(joined.timings.connections, joined.timings.render);
+  s.mode = SamplingMode::Brdf;
+  const RenderJobResult alone = runRenderJob(s);
+  EXPECT_EQ(alone.connectionPaths, 0);
+  EXPECT_EQ(alone.timings.connections, 0.0);
+}
+
 // `--sampler random` changes the numbers, never what the estimators converge to. The random sampler's
 // image mean is noisy on the light's edge pixels (random jitter): its spread over seeds was 0.53 % at
 // 512 spp and 32x32 (8 seeds, mean -0.15 %), the stratified one's 0.06 %; at 1024 spp, 2 % is 5 sigma.
