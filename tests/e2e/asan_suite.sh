@@ -26,18 +26,23 @@ export LSAN_OPTIONS="suppressions=$repo/tests/sanitizers/lsan.supp:print_suppres
 skip="asan_suite|tsan_session|fuzz_loader|gltf_validator"
 skip+="|Preview\\.(PassesLeaveNoSteps|CoarseFirstPreview|SumsThePaths|PixelChoice|FirstPassesConverge)"
 skip+="|ScalingTheSceneLeavesThePreviewsDistributionUnchanged"
-skip+="|CyclesAnchor|PixelByPixel/two_rooms_(mis|metropolis|mixture|mis_chain|mis_fixed_probability|mis_every_vertex)( |\$)"
-skip+="|PixelByPixel/door_ajar_brdf_connections"  # cornell_glossy_brdf_vpl_roulette_connections: brdf's joins
 # Likewise the cases whose every feature another case left in runs (a mode on another scene, or a
 # subset of a combination's flags): a sanitizer needs each code path once, the plain suite keeps each
-# case's statistical verdict. In parentheses the case that runs its code here (together 300 of the 1440
-# core-seconds of this suite's tests in the fresh-clone run of 188ac59):
-skip+="|PixelByPixel/(cornell_box_mis|cornell_box_metropolis|cornell_box_mixture"  # (cornell_glossy_mis, _metropolis, _mixture)
-skip+="|door_ajar_mixture"                                                           # (cornell_glossy_mixture)
-skip+="|cornell_box_brdf_vpl_roulette"                                               # (cornell_glossy_brdf_vpl_roulette_connections)
-skip+="|cornell_glossy_metropolis_every_vertex"                                      # (its _vpl_roulette twin)
-skip+="|two_rooms_mixture_every_vertex"                                              # (cornell_glossy_mixture, metropolis_every_vertex_vpl_roulette)
-skip+="|two_rooms_mis_vpl_roulette)( |\$)"                                          # (the same two vpl_roulette cases)
+# case's statistical verdict. Beside each, the case that runs its code here (the last eight together
+# 300 of the 1440 core-seconds of this suite's tests in the fresh-clone run of 188ac59):
+covered=(
+  two_rooms_mis two_rooms_metropolis two_rooms_mixture  # cornell_glossy_mis, _metropolis, _mixture
+  two_rooms_mis_chain two_rooms_mis_fixed_probability   # cornell_glossy_mis_chain, _mis_every_vertex_fixed_probability
+  two_rooms_mis_every_vertex                            # cornell_glossy_mis_every_vertex_fixed_probability
+  door_ajar_brdf_connections                            # cornell_glossy_brdf_vpl_roulette_connections: brdf's joins
+  cornell_box_mis cornell_box_metropolis cornell_box_mixture  # cornell_glossy_mis, _metropolis, _mixture
+  door_ajar_mixture                                     # cornell_glossy_mixture
+  cornell_box_brdf_vpl_roulette                         # cornell_glossy_brdf_vpl_roulette_connections
+  cornell_glossy_metropolis_every_vertex                # its _vpl_roulette twin
+  two_rooms_mixture_every_vertex                        # cornell_glossy_mixture, _metropolis_every_vertex_vpl_roulette
+  two_rooms_mis_vpl_roulette                            # the same two vpl_roulette cases
+)
+skip+="|CyclesAnchor|PixelByPixel/($(IFS='|'; echo "${covered[*]}"))( |\$)"
 # Learned light sampling's agreement under the sky and in mis (2 x 12 x 512 spp each, 3 min under the
 # sanitizers): their code runs here in brdf's agreement and in the per-sample tests of EmitterGuide.
 skip+="|EmitterGuide\\.(MisConvergesToBrdfWithLearning|BrdfUnderTheSkyConvergesToTheSameImageWithLearning)"
