@@ -23,7 +23,8 @@ Bsdf::Bsdf(const BsdfParams& params, const Frame& shadingFrame) : params_(params
   params_.diffuse = glm::clamp(params_.diffuse, glm::vec3(0.0f), glm::vec3(1.0f));
   params_.f0 = glm::clamp(params_.f0, glm::vec3(0.0f), glm::vec3(1.0f));
   params_.f90 = std::clamp(params_.f90, 0.0f, 1.0f);
-  if (!isBlack(params_.diffuse) && !hasSpecular()) {
+  lambertian_ = !hasSpecular();
+  if (!isBlack(params_.diffuse) && lambertian_) {
     diffuseScale_ = params_.diffuse * kInvPi;  // pure Lambertian: no coupling needed
   } else if (!isBlack(params_.diffuse)) {
     const AlbedoTerms avg = averageSpecularAlbedo(params_.alpha);
@@ -99,27 +100,44 @@ float Bsdf::pdfLocal(const Outgoing& o, const glm::vec3& wi) const {
   return pdf;
 }
 
+// The Lambertian shortcuts below compute what evalLocal, pdfLocal and sampleLobe give without a
+// specular lobe, with the same arithmetic (images are bit-identical), from the cosines alone.
 glm::vec3 Bsdf::eval(const glm::vec3& wo, const glm::vec3& wi) const {
+  if (lambertian_) {
+    const float cosIn = glm::dot(wi, frame_.n);
+    return cosOutgoing(wo) <= 0.0f || cosIn <= 0.0f ? glm::vec3(0.0f) : diffuseScale_ * cosIn;
+  }
   return evalLocal(outgoing(wo), frame_.toLocal(wi));
 }
 
 float Bsdf::pdf(const glm::vec3& wo, const glm::vec3& wi) const {
+  if (lambertian_) {
+    const float cosIn = glm::dot(wi, frame_.n);
+    return cosOutgoing(wo) <= 0.0f || cosIn <= 0.0f ? 0.0f : cosineHemispherePdf(cosIn);
+  }
   return pdfLocal(outgoing(wo), frame_.toLocal(wi));
 }
 
 Bsdf::Evaluation Bsdf::evalPdf(const glm::vec3& wo, const glm::vec3& wi) const {
+  if (lambertian_) {
+    const float cosIn = glm::dot(wi, frame_.n);
+    if (cosOutgoing(wo) <= 0.0f || cosIn <= 0.0f) return {};
+    return {diffuseScale_ * cosIn, cosineHemispherePdf(cosIn)};
+  }
   const Outgoing o = outgoing(wo);
   const glm::vec3 local = frame_.toLocal(wi);
   return {evalLocal(o, local), pdfLocal(o, local)};
 }
 
 std::optional<BsdfSample> Bsdf::sample(const glm::vec3& woWorld, glm::vec2 u, float uLobe) const {
+  if (lambertian_) return cosOutgoing(woWorld) <= 0.0f ? std::nullopt : sampleLambertian(u);
   const Outgoing o = outgoing(woWorld);
   if (o.local.z <= 0.0f) return std::nullopt;
   return sampleLobe(o, u, uLobe < o.specularProbability);
 }
 
 std::optional<BsdfSample> Bsdf::sample(const glm::vec3& woWorld, glm::vec2 u) const {
+  if (lambertian_) return cosOutgoing(woWorld) <= 0.0f ? std::nullopt : sampleLambertian(glm::vec2(std::min(u.x, 0x1.fffffep-1f), u.y));
   const Outgoing o = outgoing(woWorld);
   if (o.local.z <= 0.0f) return std::nullopt;
   const float pSpec = o.specularProbability;
@@ -135,12 +153,8 @@ std::optional<BsdfSample> Bsdf::sampleLobe(const Outgoing& o, glm::vec2 u, bool 
     const glm::vec3 h = ggx::sampleVisibleNormal(wo, u, params_.alpha);
     wi = 2.0f * glm::dot(wo, h) * h - wo;
   } else {
+    if (lambertian_) return sampleLambertian(u);
     wi = sampleCosineHemisphere(u);
-    if (!hasSpecular()) {
-      // A lone Lambertian lobe sampled by its cosine: f cos / pdf is its albedo, no evaluation needed.
-      if (!(wi.z > 0.0f)) return std::nullopt;
-      return BsdfSample{glm::normalize(frame_.toWorld(wi)), params_.diffuse, wi.z * kInvPi};
-    }
   }
   if (wi.z <= 0.0f) return std::nullopt;
   const float pdf = pdfLocal(o, wi);
@@ -151,6 +165,13 @@ std::optional<BsdfSample> Bsdf::sampleLobe(const Outgoing& o, glm::vec2 u, bool 
   s.weight = evalLocal(o, wi) / pdf;
   if (!isFiniteNonNegative(s.weight)) return std::nullopt;
   return s;
+}
+
+// A lone Lambertian lobe sampled by its cosine: f cos / pdf is its albedo, no evaluation needed.
+std::optional<BsdfSample> Bsdf::sampleLambertian(glm::vec2 u) const {
+  const glm::vec3 wi = sampleCosineHemisphere(u);
+  if (!(wi.z > 0.0f)) return std::nullopt;
+  return BsdfSample{glm::normalize(frame_.toWorld(wi)), params_.diffuse, wi.z * kInvPi};
 }
 
 bool Bsdf::isNearSpecular() const {

@@ -73,6 +73,7 @@ class Bsdf {
   BsdfParams params_;
   Frame frame_;
   glm::vec3 diffuseScale_{0.0f};  // diffuse / (pi (1 - E_avg)): the coupled diffuse lobe's constant
+  bool lambertian_ = false;       // no specular lobe: evaluations, densities and samples need only the cosines
 
   // What eval, pdf and sample need of wo besides wo itself (local frame).
   struct Outgoing {
@@ -92,6 +93,11 @@ class Bsdf {
   float specularProbability(const glm::vec3& albedo) const;
   Outgoing outgoingTerms(const glm::vec3& woWorld) const;
   Outgoing outgoing(const glm::vec3& woWorld) const { return bound_ && woWorld == boundWo_ ? outgoing_ : outgoingTerms(woWorld); }
+  // wo's cosine with the shading normal: all a Lambertian lobe needs of wo.
+  float cosOutgoing(const glm::vec3& woWorld) const {
+    return bound_ && woWorld == boundWo_ ? outgoing_.local.z : glm::dot(woWorld, frame_.n);
+  }
+  std::optional<BsdfSample> sampleLambertian(glm::vec2 u) const;
   std::optional<BsdfSample> sampleLobe(const Outgoing& wo, glm::vec2 u, bool specular) const;
   glm::vec3 evalLocal(const Outgoing& wo, const glm::vec3& wi) const;
   float pdfLocal(const Outgoing& wo, const glm::vec3& wi) const;

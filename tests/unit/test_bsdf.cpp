@@ -150,6 +150,19 @@ TEST(Bsdf, PureLambertianWhenNoSpecular) {
     const glm::vec3 f = bsdf.eval(wo, wi);
     const glm::vec3 expected = glm::vec3(0.6f, 0.3f, 0.1f) / 3.14159265f * cosI;
     for (int k = 0; k < 3; ++k) ASSERT_NEAR(f[k], expected[k], 1e-5f);
+    // The Lambertian shortcuts agree with each other, bound to wo or not, and see wo's side.
+    Bsdf bound = bsdf;
+    bound.bindOutgoing(wo);
+    const Bsdf::Evaluation both = bsdf.evalPdf(wo, wi);
+    ASSERT_EQ(both.f, f);
+    ASSERT_EQ(both.pdf, bsdf.pdf(wo, wi));
+    ASSERT_NEAR(both.pdf, cosI / 3.14159265f, 1e-5f);
+    ASSERT_EQ(bound.eval(wo, wi), f);
+    ASSERT_EQ(bound.pdf(wo, wi), both.pdf);
+    const glm::vec3 below = bsdf.frame().toWorld(directionWithCos(-0.5f, 1.0f));
+    ASSERT_EQ(bsdf.eval(below, wi), glm::vec3(0.0f));
+    ASSERT_EQ(bsdf.pdf(below, wi), 0.0f);
+    ASSERT_FALSE(bsdf.sample(below, glm::vec2(0.3f, 0.6f)).has_value());
   }
   EXPECT_FALSE(bsdf.isNearSpecular());
 }
