@@ -64,20 +64,20 @@ glm::vec3 offsetRayOrigin(const glm::vec3& p, const glm::vec3& n, float coordina
   // Wächter and Binder's offset (Ray Tracing Gems, ch. 6): 256 ulps away from the surface, and near
   // zero, where ulps vanish, a fixed share of the coordinate scale (their constants assume a scale of 1:
   // the Cornell box scaled by 1e-4 lost 16 % of its light with them).
+  // The three coordinates at once in 4-wide vectors: one shadow ray and one continuation a vertex
+  // each pay this (2.7 % of a mis render's instructions as a loop over the coordinates).
+  typedef float Float4 __attribute__((vector_size(16)));
+  typedef int32_t Int4 __attribute__((vector_size(16)));
   const float scale = coordinateScale > 0.0f && std::isfinite(coordinateScale) ? coordinateScale : 1.0f;
   const float kOrigin = scale / 32.0f, kFloatScale = scale / 65536.0f;
   constexpr float kIntScale = 256.0f;
-  glm::vec3 out;
-  for (int i = 0; i < 3; ++i) {
-    const int32_t offset = int32_t(kIntScale * n[i]);
-    int32_t bits;
-    std::memcpy(&bits, &p[i], sizeof(float));
-    bits += (p[i] < 0.0f) ? -offset : offset;
-    float moved;
-    std::memcpy(&moved, &bits, sizeof(float));
-    out[i] = std::abs(p[i]) < kOrigin ? p[i] + kFloatScale * n[i] : moved;
-  }
-  return out;
+  const Float4 p4 = {p.x, p.y, p.z, 0.0f}, n4 = {n.x, n.y, n.z, 0.0f};
+  const Int4 offset = __builtin_convertvector(kIntScale * n4, Int4);
+  const Int4 negative = p4 < 0.0f;                       // -1 where p < 0: the offset's sign flips
+  const Int4 bits = (Int4)p4 + ((offset ^ negative) - negative);
+  const Int4 nearZero = (Float4)((Int4)p4 & 0x7fffffff) < kOrigin;  // |p| < kOrigin
+  const Float4 out = nearZero ? p4 + kFloatScale * n4 : (Float4)bits;
+  return {out[0], out[1], out[2]};
 }
 
 Accel::Accel(const SceneData& scene) {

@@ -2,7 +2,9 @@
 // 1e-4 and 1e4, an emitter a million times brighter, the camera inside geometry, a million VPLs.
 // Each asserts a property of the image, not only that nothing crashed.
 #include <cmath>
+#include <cstring>
 #include "render/film/image_metrics.h"
+#include "render/scene/accel.h"
 #include "render/scene/gltf_loader.h"
 #include "render/session/render_job.h"
 #include "tests/unit/pixel_agreement.h"
@@ -44,6 +46,32 @@ SceneData scaled(SceneData data, float s) {
   data.boundsMin *= s;
   data.boundsMax *= s;
   return data;
+}
+
+// The ray origin offset at every scale: 256 ulps along the normal (away from zero where the normal
+// points away from it), except within a 32nd of the coordinate scale of zero, where ulps vanish and a
+// 65536th of the scale is added instead.
+TEST(Extremes, RayOffsetsAreUlpsAlongTheNormalAndAShareOfTheScaleNearZero) {
+  const auto bitsOf = [](float x) {
+    int32_t b;
+    std::memcpy(&b, &x, sizeof b);
+    return b;
+  };
+  const glm::vec3 n = glm::normalize(glm::vec3(0.6f, -0.7f, 0.3f));
+  for (float scale : {1e-4f, 1.0f, 1e4f})
+    for (const glm::vec3 p : {glm::vec3(0.5f, -0.25f, 0.9f), glm::vec3(-0.04f, 0.02f, 0.01f), glm::vec3(0.0f, -0.5f, 0.0f)}) {
+      const glm::vec3 at = p * scale;
+      const glm::vec3 moved = offsetRayOrigin(at, n, scale);
+      for (int i = 0; i < 3; ++i) {
+        if (std::abs(at[i]) < scale / 32.0f) {
+          EXPECT_EQ(moved[i], at[i] + scale / 65536.0f * n[i]) << "scale " << scale << " axis " << i;
+        } else {
+          const int32_t ulps = int32_t(256.0f * n[i]);
+          EXPECT_EQ(bitsOf(moved[i]) - bitsOf(at[i]), at[i] < 0.0f ? -ulps : ulps) << "scale " << scale << " axis " << i;
+          EXPECT_GT((moved[i] - at[i]) * n[i], 0.0f) << "scale " << scale << " axis " << i;  // along n
+        }
+      }
+    }
 }
 
 TEST(Extremes, ScalingTheSceneLeavesTheImageUnchanged) {
