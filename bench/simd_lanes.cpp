@@ -33,6 +33,7 @@ using namespace vpl;
 namespace {
 
 constexpr int kMaxDepth = 32, kRouletteStart = 5;
+constexpr uint64_t kSeed = 1;
 constexpr float kInvPiF = std::numbers::inv_pi_v<float>;
 
 // What a hit needs of its triangle, flattened over all meshes (index: meshBase[mesh] + primitive).
@@ -117,12 +118,14 @@ struct VectorTypes<1> {
   typedef float F __attribute__((vector_size(4)));
   typedef int32_t I __attribute__((vector_size(4)));
   typedef uint32_t U __attribute__((vector_size(4)));
+  typedef uint64_t U64 __attribute__((vector_size(8)));
 };
 template <>
 struct VectorTypes<8> {
   typedef float F __attribute__((vector_size(32)));
   typedef int32_t I __attribute__((vector_size(32)));
   typedef uint32_t U __attribute__((vector_size(32)));
+  typedef uint64_t U64 __attribute__((vector_size(64)));
 };
 
 template <int N>
@@ -175,6 +178,50 @@ struct Lanes {
   }
 };
 
+// PixelSampler's stratified numbers (render/sampling/pixel_sampler.h, sobol.h) for N lanes at once:
+// the same hashes, scrambles and bit reversals in vector arithmetic (main() checks them against
+// PixelSampler, number for number). Only the second Sobol' dimension's table is read lane by lane.
+template <int N>
+struct LaneSobol {
+  using F = typename VectorTypes<N>::F;
+  using U = typename VectorTypes<N>::U;
+  using U64 = typename VectorTypes<N>::U64;
+
+  static U reverseBits(U x) {
+    x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
+    x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
+    x = ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
+    x = ((x >> 8) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8);
+    return (x >> 16) | (x << 16);
+  }
+  static U scramble(U x, U seed) {
+    x ^= x * 0x3d20adeau;
+    x += seed;
+    x *= (seed >> 16) | 1u;
+    x ^= x * 0x05526c56u;
+    x ^= x * 0x53a22864u;
+    return x;
+  }
+  static U64 mix64(U64 x) {
+    x += 0x9e3779b97f4a7c15ull;
+    x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+    x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+    return x ^ (x >> 31);
+  }
+  static U low(U64 x) { return __builtin_convertvector(x, U); }
+  static F unit(U v) { return __builtin_convertvector(v >> 8, F) * 0x1p-24f; }
+
+  // Both coordinates of each lane's slot (a slot per lane: lanes are at different depths).
+  static void point(U64 pixelKey, U reversedIndex, U slot, F& x, F& y) {
+    const U64 slotHash = mix64(pixelKey + __builtin_convertvector(slot, U64));
+    const U index = reverseBits(scramble(reversedIndex, low(slotHash)));
+    x = unit(reverseBits(scramble(index, low(slotHash >> 32))));
+    U second;
+    for (int k = 0; k < N; ++k) second[k] = sobol::reversedSobolSecond(index[k]);
+    y = unit(reverseBits(scramble(second, low(mix64(slotHash)))));
+  }
+};
+
 // The lanes' paths and their traversal, N at a time.
 template <int N>
 class Wavefront {
@@ -190,10 +237,12 @@ class Wavefront {
   // `framework`, per lane, cumulative: 1 the hit's SurfaceHit (RenderScene::surface) instead of the
   // flat arrays, 2 its Bsdf object instead of an inline Lambertian lobe, 3 the renderer's ray offsets
   // (spawnRay, spawnShadowRay) instead of a fixed one. At 3 the estimator is radiance()'s.
+  // `laneSobol` (with `sobol`): the stratified numbers of the first PixelSampler::kTabulatedVertices
+  // vertices drawn for all lanes at once (LaneSobol), not lane by lane.
   Wavefront(const RenderScene& scene, const FlatScene& flat, const Camera& camera, bool sobol, bool solidAngle,
-            int framework = 0)
+            int framework = 0, bool laneSobol = false)
       : scene_(scene.accel().handle()), renderScene_(scene), emitters_(scene.emitters()), flat_(flat), camera_(camera),
-        sobol_(sobol), solidAngle_(solidAngle), framework_(framework) {}
+        sobol_(sobol), solidAngle_(solidAngle), framework_(framework), laneSobol_(laneSobol && sobol) {}
 
   // Every pixel's samples [0, passes); returns the sum of the samples' luminances.
   double render(int passes) {
@@ -222,7 +271,10 @@ class Wavefront {
     const uint32_t pixel = uint32_t(s % pixels), pass = uint32_t(s / pixels);
     key_[k] = hash32(pixel * 0x632be59bu ^ hash32(pass + 0x85ebca6bu));
     glm::vec2 jitter(L::unit(U{} + hash32(key_[k] ^ 0x1u))[0], L::unit(U{} + hash32(key_[k] ^ 0x2u))[0]);
-    if (sobol_) jitter = samplers_[k].emplace(1, pixel, pass).cameraJitter();
+    if (sobol_) jitter = samplers_[k].emplace(kSeed, pixel, pass).cameraJitter();
+    // PixelSampler's keys, as its constructor makes them (main() checks that they agree).
+    pixelKey_[k] = mix64(mix64(kSeed ^ 0x736f626f6c000000ull) ^ pixel) ^ mix64(uint64_t(pass) >> 32);
+    reversedIndex_[k] = sobol::reverseBits(pass);
     const Ray r = camera_.generateRay(glm::vec2(float(pixel % uint32_t(camera_.width())), float(pixel / uint32_t(camera_.width()))) + jitter);
     ox_[k] = r.origin.x, oy_[k] = r.origin.y, oz_[k] = r.origin.z;
     dx_[k] = r.direction.x, dy_[k] = r.direction.y, dz_[k] = r.direction.z;
@@ -356,11 +408,24 @@ class Wavefront {
 
     // The vertex's numbers: light point (and choice), direction, roulette.
     std::optional<VertexSamples> numbers[N];
+    const I vertex = depth_;
+    const auto scalarNumbers = [&](int k) -> VertexSamples& {
+      return numbers[k] ? *numbers[k] : numbers[k].emplace(*samplers_[k], vertex[k]);
+    };
+    const U firstSlot = 2u + U(depth_) * uint32_t(VertexDimension::Count);  // PixelSampler::slotOf
     F uLight0, uLight1, uDir0, uDir1;
-    if (sobol_) {
+    if (laneSobol_) {
+      LaneSobol<N>::point(pixelKey_, reversedIndex_, firstSlot + uint32_t(VertexDimension::LightPoint), uLight0, uLight1);
+      LaneSobol<N>::point(pixelKey_, reversedIndex_, firstSlot + uint32_t(VertexDimension::BsdfDirection), uDir0, uDir1);
+      for (int k = 0; k < N; ++k)  // past the tabulated vertices: the sampler's hashed numbers
+        if (alive_[k] && depth_[k] >= PixelSampler::kTabulatedVertices) {
+          const glm::vec2 a = scalarNumbers(k).lightPoint(), b = scalarNumbers(k).bsdfDirection();
+          uLight0[k] = a.x, uLight1[k] = a.y, uDir0[k] = b.x, uDir1[k] = b.y;
+        }
+    } else if (sobol_) {
       for (int k = 0; k < N; ++k)
         if (alive_[k]) {
-          VertexSamples& v = numbers[k].emplace(*samplers_[k], depth_[k]);
+          VertexSamples& v = scalarNumbers(k);
           const glm::vec2 a = v.lightPoint(), b = v.bsdfDirection();
           uLight0[k] = a.x, uLight1[k] = a.y, uDir0[k] = b.x, uDir1[k] = b.y;
         }
@@ -376,7 +441,7 @@ class Wavefront {
       for (int k = 0; k < N; ++k) {
         if (!alive_[k]) continue;
         const auto ls = emitters_.sampleStratified(glm::vec3(px[k], py[k], pz[k]), glm::vec2(uLight0[k], uLight1[k]), [&] {
-          return sobol_ ? numbers[k]->lightChoice() : L::uniform(key, 5)[k];
+          return sobol_ ? scalarNumbers(k).lightChoice() : L::uniform(key, 5)[k];
         });
         if (!ls || !(ls->pdf > 0.0f)) continue;
         wx[k] = ls->wi.x, wy[k] = ls->wi.y, wz[k] = ls->wi.z, dist[k] = ls->distance, lightPdf[k] = ls->pdf;
@@ -486,9 +551,13 @@ class Wavefront {
     const I rolls = alive_ & (depth_ >= kRouletteStart);
     if (L::any(rolls)) {
       F uRoulette = L::uniform(key, 4);
+      if (laneSobol_) {
+        F unused;
+        LaneSobol<N>::point(pixelKey_, reversedIndex_, firstSlot + uint32_t(VertexDimension::LightChoiceRoulette), unused, uRoulette);
+      }
       if (sobol_)
         for (int k = 0; k < N; ++k)
-          if (rolls[k]) uRoulette[k] = numbers[k]->roulette();
+          if (rolls[k] && (!laneSobol_ || vertex[k] >= PixelSampler::kTabulatedVertices)) uRoulette[k] = scalarNumbers(k).roulette();
       const F survive = L::min(L::splat(1.0f), L::sqrt(L::max(br_, L::max(bg_, bb_))));
       const I killed = rolls & (uRoulette >= survive);
       const F scale = rolls ? 1.0f / survive : L::splat(1.0f);
@@ -509,7 +578,10 @@ class Wavefront {
   const Camera& camera_;
   bool sobol_, solidAngle_;
   int framework_;
+  bool laneSobol_;
   std::optional<PixelSampler> samplers_[N];
+  typename VectorTypes<N>::U64 pixelKey_{};
+  U reversedIndex_{};
   F ox_{}, oy_{}, oz_{}, dx_{}, dy_{}, dz_{}, br_{}, bg_{}, bb_{}, Lr_{}, Lg_{}, Lb_{}, prevPdf_{}, prevX_{}, prevY_{}, prevZ_{};
   I depth_{}, alive_{}, finished_{};
   U key_{};
@@ -537,6 +609,31 @@ double renderRadiance(const PathTracer& tracer, const Camera& camera, int passes
   return sum;
 }
 
+// LaneSobol against PixelSampler, number for number, over pixels, sample indices and vertices.
+bool laneSobolAgrees() {
+  using V = VectorTypes<8>;
+  for (uint64_t pass : {0ull, 1ull, 5ull, 1000ull, 0x100000003ull})
+    for (uint32_t vertex = 0; vertex < uint32_t(PixelSampler::kTabulatedVertices); ++vertex)
+      for (VertexDimension d : {VertexDimension::LightPoint, VertexDimension::BsdfDirection, VertexDimension::LightChoiceRoulette}) {
+        V::U64 keys;
+        V::U reversed, slot;
+        for (int k = 0; k < 8; ++k) {
+          const uint64_t pixel = uint64_t(k) * 7919u + pass;
+          keys[k] = mix64(mix64(kSeed ^ 0x736f626f6c000000ull) ^ pixel) ^ mix64(pass >> 32);
+          reversed[k] = sobol::reverseBits(uint32_t(pass));
+          slot[k] = 2u + vertex * uint32_t(VertexDimension::Count) + uint32_t(d);
+        }
+        V::F x, y;
+        LaneSobol<8>::point(keys, reversed, slot, x, y);
+        for (int k = 0; k < 8; ++k) {
+          PixelSampler sampler(kSeed, uint64_t(k) * 7919u + pass, pass);
+          const glm::vec2 expected = sampler.get2D(int(vertex), d);
+          if (x[k] != expected.x || y[k] != expected.y) return false;
+        }
+      }
+  return true;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -553,6 +650,10 @@ int main(int argc, char** argv) {
     if (const char* why = FlatScene::unsupported(scene.data())) {
       std::fprintf(stderr, "simd_lanes: the scene has %s, which this bound does not model\n", why);
       return 2;
+    }
+    if (!laneSobolAgrees()) {
+      std::fprintf(stderr, "simd_lanes: LaneSobol disagrees with PixelSampler\n");
+      return 1;
     }
     const FlatScene flat(scene.data());
     if (flat.lights.empty()) {
@@ -581,7 +682,8 @@ int main(int argc, char** argv) {
         solid1(scene, flat, camera, false, true), both1(scene, flat, camera, true, true);
     Wavefront<1> surface1(scene, flat, camera, true, true, 1), bsdf1(scene, flat, camera, true, true, 2),
         offsets1(scene, flat, camera, true, true, 3);
-    Wavefront<8> lean8(scene, flat, camera, false, false), both8(scene, flat, camera, true, true);
+    Wavefront<8> lean8(scene, flat, camera, false, false), both8(scene, flat, camera, true, true),
+        laneNumbers8(scene, flat, camera, true, false, 0, true), laneBoth8(scene, flat, camera, true, true, 0, true);
     std::vector<Variant> variants;
     variants.push_back({"radiance()", [&] { return renderRadiance(tracer, camera, passes); }, {}});
     variants.push_back({"1 lane, lean", [&] { return lean1.render(passes); }, {}});
@@ -593,6 +695,8 @@ int main(int argc, char** argv) {
     variants.push_back({"1 lane, + offsets", [&] { return offsets1.render(passes); }, {}});
     variants.push_back({"8 lanes, lean", [&] { return lean8.render(passes); }, {}});
     variants.push_back({"8 lanes, both", [&] { return both8.render(passes); }, {}});
+    variants.push_back({"8 lanes, lane Sobol'", [&] { return laneNumbers8.render(passes); }, {}});
+    variants.push_back({"8 lanes, lane Sobol', solid angle", [&] { return laneBoth8.render(passes); }, {}});
     const double samples = double(width) * height * passes;
     for (int round = 0; round < rounds; ++round)
       for (Variant& v : variants) {
