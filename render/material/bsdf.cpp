@@ -153,8 +153,7 @@ std::optional<BsdfSample> Bsdf::sampleLobe(const Outgoing& o, glm::vec2 u, bool 
     const glm::vec3 h = ggx::sampleVisibleNormal(wo, u, params_.alpha);
     wi = 2.0f * glm::dot(wo, h) * h - wo;
   } else {
-    if (lambertian_) return sampleLambertian(u);
-    wi = sampleCosineHemisphere(u);
+    wi = sampleCosineHemisphere(u);  // the diffuse lobe beside a specular one (a lone one: sampleLambertian)
   }
   if (wi.z <= 0.0f) return std::nullopt;
   const float pdf = pdfLocal(o, wi);
