@@ -42,7 +42,8 @@ class Bsdf {
   // compute their own; a bound BSDF belongs to one thread, as a path vertex does.
   void bindOutgoing(const glm::vec3& wo) {
     bound_ = false;
-    outgoing_ = outgoingTerms(wo);
+    // A lone Lambertian lobe reads only wo's cosine (cosOutgoing), toLocal(wo).z.
+    outgoing_ = lambertian_ ? Outgoing{glm::vec3(0.0f, 0.0f, glm::dot(wo, frame_.n))} : outgoingTerms(wo);
     boundWo_ = wo;
     bound_ = true;
   }
