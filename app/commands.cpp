@@ -59,6 +59,8 @@ nlohmann::ordered_json summaryJson(const RenderJobSettings& s, const RenderJobRe
   j["bsdf_samples"] = r.bsdfSamples;
   j["guide_samples"] = r.guideSamples;
   j["triangles"] = r.triangles;
+  // Paths traced at once: 8 where brdf's lanes applied (render/integrator/path_lanes.h), else 1.
+  j["lanes"] = r.lanes;
   // Learned next-event estimation: the share of the scene's regions that sample from what they learned
   // (null: off, or not for this scene's lights).
   if (s.mode != SamplingMode::Preview)

@@ -106,6 +106,11 @@ void RenderOptions::addCommonTo(CLI::App& command) {
             "what its light samples brought back in earlier passes, 30 % by power; triangle lights only) | off "
             "(by power, then by solid angle or area)")
       ->check(CLI::IsMember({"on", "off"}));
+  command.add_option_function<std::string>(
+            "--lanes", [this](const std::string& v) { tracer.lanes = v == "auto"; },
+            "brdf: auto (the default; eight paths at a time in AVX2 lanes where the scene has only Lambertian, untextured, "
+            "flat-shaded opaque materials and no VPL weight window is in use) | off (one path at a time everywhere)")
+      ->check(CLI::IsMember({"auto", "off"}));
   command.add_option("--sky", sky, "uniform sky radiance R,G,B; 0 turns it off (default: on only without lights)");
   command.add_option("--sampler", sampler,
                      "the camera paths' numbers: sobol (stratified: Owen-scrambled Sobol', one slot per decision) | "

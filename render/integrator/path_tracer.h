@@ -34,6 +34,9 @@ struct PathTracerSettings {
   // Next-event estimation learns which part of which emitter each region sees (EmitterGuide); the
   // tracer's owner makes the guide, since it learns between passes.
   bool learnLights = true;
+  // `brdf` samples eight at a time in vector lanes where the scene allows (path_lanes.h); false: one
+  // at a time through radiance() everywhere.
+  bool lanes = true;
 
   // Empty when valid, else a readable reason.
   std::string validate() const;
@@ -128,6 +131,11 @@ class PathTracer {
   }
 
   const PathTracerSettings& settings() const { return settings_; }
+  const RenderScene& scene() const { return scene_; }
+  // What radiance() uses beside the BSDF and the emitters (null when not in use).
+  const EmitterGuide* emitterGuide() const { return emitterGuide_; }
+  bool usesWeightWindow() const { return irradiance_ != nullptr; }
+  bool joinsLightVertices() const { return connections_ != nullptr; }
 
  private:
   struct Branch;

@@ -67,6 +67,8 @@ class Bsdf {
 
   const BsdfParams& params() const { return params_; }
   const Frame& frame() const { return frame_; }
+  // A lone Lambertian lobe (no specular one): f = diffuse / pi, sampled by the cosine.
+  bool lambertian() const { return lambertian_; }
   // True when nearly all reflection is a narrow lobe, so a light path should not store a VPL here.
   bool isNearSpecular() const;
 

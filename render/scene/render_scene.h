@@ -37,6 +37,13 @@ class RenderScene {
   // True when the sky was switched on because the scene has no light (the CLI prints a notice).
   bool usesDefaultSky() const { return defaultSky_; }
 
+  // What a hit needs of its triangle that no ray changes: made once, read at every hit.
+  struct TriangleFacts {
+    glm::vec3 normal{0.0f};  // unit winding normal; zero for a degenerate triangle
+    float coordinateScale = 1.0f;
+  };
+  const TriangleFacts& triangleFacts(uint32_t mesh, uint32_t triangle) const { return triangles_[mesh][triangle]; }
+
   // Shading point of a hit; wo is the unit direction back along the ray.
   SurfaceHit surface(const Ray& ray, const RayHit& hit) const;
   // BSDF parameters at a hit: texture lookups only for textured materials.
@@ -55,12 +62,6 @@ class RenderScene {
 
  private:
   BsdfParams bsdfParams(const Material& material, const SurfaceHit& hit) const;
-
-  // What a hit needs of its triangle that no ray changes: made once, read at every hit.
-  struct TriangleFacts {
-    glm::vec3 normal{0.0f};  // unit winding normal; zero for a degenerate triangle
-    float coordinateScale = 1.0f;
-  };
 
   SceneData data_;
   std::vector<std::vector<TriangleFacts>> triangles_;  // per mesh, per triangle

@@ -151,7 +151,19 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
     shaderFor = [](const PathTracer& t) { return pathTracerShader(t); };
   }
   std::optional<TileRenderer> renderer;
-  renderer.emplace(camera, settings.seed, shaderFor(*tracer), settings.stratifiedSampler);
+  std::optional<PathLanes> lanes;
+  // `brdf` through the lanes wherever they model the tracer exactly (path_lanes.h).
+  const auto makeRenderer = [&] {
+    renderer.reset();  // its shader or lanes hold the old tracer
+    lanes.reset();
+    if (settings.mode == SamplingMode::Brdf && settings.stratifiedSampler && PathLanes::unsupported(*tracer).empty()) {
+      renderer.emplace(camera, settings.seed, lanes.emplace(*tracer));
+    } else {
+      renderer.emplace(camera, settings.seed, shaderFor(*tracer), settings.stratifiedSampler);
+    }
+    result.lanes = lanes ? PathLanes::kLanes : 1;
+  };
+  makeRenderer();
   Film film(settings.width, settings.height);
   // The auto rule: the film's first passes decide whether the window is used.
   const bool autoRoulette = settings.tracer.roulette == RouletteRule::Auto && settings.mode != SamplingMode::Preview;
@@ -203,9 +215,10 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
     if (autoRoulette && !window.on() && WindowSwitch::updateDue(uint64_t(result.spp))) {
       if (window.update(film)) {
         result.windowFromPass = result.spp;
-        renderer.reset();  // its shader holds the old tracer
+        renderer.reset();
+        lanes.reset();
         tracer = windowTracer();
-        renderer.emplace(camera, settings.seed, shaderFor(*tracer), settings.stratifiedSampler);
+        makeRenderer();
       }
     }
     if (progress) progress(timed ? std::min(1.0, secondsSince(loaded) / settings.timeBudget) : double(pass + 1) / settings.spp);

@@ -63,6 +63,7 @@ struct RenderJobResult {
   int connectionPaths = 0;               // VPL connections: light paths per pass (0: none)
   double learnedBsdfProbability = -1.0;  // mis: the mean learned BSDF probability over cache points (-1: none)
   double learnedLightRegions = -1.0;     // learned next-event estimation: the share of regions that learned (-1: off)
+  int lanes = 1;                         // paths traced at once: PathLanes::kLanes where the lanes applied, else 1
   double learnedGuideShare = -1.0;       // learned guides: the mean weight of what was learned against the VPLs
   size_t guideBytes = 0;
   std::vector<std::string> notices;

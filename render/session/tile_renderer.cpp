@@ -28,6 +28,11 @@ TileRenderer::TileRenderer(const Camera& camera, uint64_t seed, PixelShaderFacto
     : camera_(camera), seed_(seed), shader_(std::move(shader)), stratified_(stratified),
       tilesX_((camera.width() + kTileSize - 1) / kTileSize), tilesY_((camera.height() + kTileSize - 1) / kTileSize) {}
 
+TileRenderer::TileRenderer(const Camera& camera, uint64_t seed, const PathLanes& lanes)
+    : TileRenderer(camera, seed, PixelShaderFactory{}, true) {
+  lanes_ = &lanes;
+}
+
 PassStats TileRenderer::renderPass(Film& film, uint64_t pass, const std::atomic<bool>* stop, Film* counterfactual,
                                    int counterfactualDepth) const {
   tbb::combinable<PassStats> perThread;
@@ -36,26 +41,31 @@ PassStats TileRenderer::renderPass(Film& film, uint64_t pass, const std::atomic<
     if (stop && stop->load(std::memory_order_relaxed)) return;
     PassStats& stats = perThread.local();
     PathStats path;
-    const PixelShader shade = shader_(uint32_t(tile), pass);
     const int x0 = (tile % tilesX_) * kTileSize, y0 = (tile / tilesX_) * kTileSize;
     const int x1 = std::min(x0 + kTileSize, width), y1 = std::min(y0 + kTileSize, height);
-    for (int y = y0; y < y1; ++y)
-      for (int x = x0; x < x1; ++x) {
-        const uint64_t pixel = uint64_t(y) * uint64_t(width) + uint64_t(x);
-        PixelSampler sampler(seed_, pixel, pass, stratified_);
-        const Ray ray = camera_.generateRay(glm::vec2(float(x), float(y)) + sampler.cameraJitter());
-        JoinDepthCounterfactual alternative{counterfactualDepth};
-        // Set to the sample's own by any shader that does not weigh one.
-        alternative.L = glm::vec3(-1.0f);
-        const glm::vec3 L = shade(ray, pixel, sampler, path, counterfactual ? &alternative : nullptr);
-        ++stats.samples;
-        if (!isFiniteNonNegative(L)) {
-          ++stats.discarded;
-          continue;
+    if (lanes_) {
+      lanes_->renderTile(camera_, seed_, pass, x0, y0, x1, y1, film, path, stats.discarded);
+      stats.samples += uint64_t(x1 - x0) * uint64_t(y1 - y0);
+    } else {
+      const PixelShader shade = shader_(uint32_t(tile), pass);
+      for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) {
+          const uint64_t pixel = uint64_t(y) * uint64_t(width) + uint64_t(x);
+          PixelSampler sampler(seed_, pixel, pass, stratified_);
+          const Ray ray = camera_.generateRay(glm::vec2(float(x), float(y)) + sampler.cameraJitter());
+          JoinDepthCounterfactual alternative{counterfactualDepth};
+          // Set to the sample's own by any shader that does not weigh one.
+          alternative.L = glm::vec3(-1.0f);
+          const glm::vec3 L = shade(ray, pixel, sampler, path, counterfactual ? &alternative : nullptr);
+          ++stats.samples;
+          if (!isFiniteNonNegative(L)) {
+            ++stats.discarded;
+            continue;
+          }
+          film.addSample(x, y, L);
+          if (counterfactual) counterfactual->addSample(x, y, isFiniteNonNegative(alternative.L) ? alternative.L : L);
         }
-        film.addSample(x, y, L);
-        if (counterfactual) counterfactual->addSample(x, y, isFiniteNonNegative(alternative.L) ? alternative.L : L);
-      }
+    }
     stats.rays += path.rays;
     stats.bsdfSamples += path.bsdfSamples;
     stats.guideSamples += path.guideSamples;

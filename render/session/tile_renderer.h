@@ -8,6 +8,7 @@
 #include <functional>
 #include <memory>
 #include "render/film/film.h"
+#include "render/integrator/path_lanes.h"
 #include "render/integrator/path_tracer.h"
 #include "render/integrator/sampling_mode.h"
 #include "render/scene/camera.h"
@@ -55,6 +56,8 @@ class TileRenderer {
 
   // `stratified` false: independent random numbers instead of the stratified sampler (PixelSampler).
   TileRenderer(const Camera& camera, uint64_t seed, PixelShaderFactory shader, bool stratified = true);
+  // `brdf` samples eight at a time: each tile through `lanes` (which must outlive the renderer).
+  TileRenderer(const Camera& camera, uint64_t seed, const PathLanes& lanes);
 
   // Adds one sample per pixel to film. Stops early (between tiles) when *stop becomes true.
   // `counterfactual`: also adds to it what each sample would have been with joins only up to camera
@@ -71,6 +74,7 @@ class TileRenderer {
   Camera camera_;
   uint64_t seed_;
   PixelShaderFactory shader_;
+  const PathLanes* lanes_ = nullptr;  // set: tiles go through the lanes, not shader_
   bool stratified_;
   int tilesX_, tilesY_;
 };

@@ -1,0 +1,372 @@
+#include "render/integrator/path_lanes.h"
+
+#include <immintrin.h>
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <optional>
+#include <embree3/rtcore.h>
+#include "render/core/color.h"
+#include "render/guide/emitter_guide.h"
+#include "render/sampling/pixel_sampler.h"
+#include "render/sampling/warps.h"
+
+namespace vpl {
+
+std::string PathLanes::unsupported(const PathTracer& tracer) {
+  if (!tracer.settings().lanes) return "--lanes off";
+  __builtin_cpu_init();
+  if (!__builtin_cpu_supports("avx2") || !__builtin_cpu_supports("fma")) return "the CPU has no AVX2 and FMA";
+  if (tracer.usesWeightWindow()) return "the VPL weight window";
+  if (tracer.joinsLightVertices()) return "VPL connections";
+  const RenderScene& scene = tracer.scene();
+  const SceneData& data = scene.data();
+  for (const Material& m : data.materials) {
+    if (m.hasTextures()) return "a textured material";
+    if (m.alphaMode != AlphaMode::Opaque) return "a material with alpha";
+  }
+  for (uint32_t mesh = 0; mesh < data.meshes.size(); ++mesh) {
+    const MeshData& m = data.meshes[mesh];
+    SurfaceHit probe;
+    probe.material = m.material;
+    if (!scene.bsdf(probe).lambertian()) return "a material with a specular lobe";
+    if (m.normals.empty()) continue;
+    for (size_t i = 0; i < m.indices.size(); ++i) {
+      const glm::vec3 ng = scene.triangleFacts(mesh, uint32_t(i / 3)).normal, n = m.normals[m.indices[i]];
+      const float length = glm::length(n);
+      // Normals along the face's, either way: surface() turns them to the face's side.
+      if (length > 1e-8f && std::isfinite(length) && std::abs(glm::dot(n / length, ng)) < 1.0f - 1e-6f)
+        return "smooth shading normals";
+    }
+  }
+  return "";
+}
+
+PathLanes::PathLanes(const PathTracer& tracer) : tracer_(tracer), scene_(tracer.scene()) {
+  const SceneData& data = scene_.data();
+  for (uint32_t mesh = 0; mesh < data.meshes.size(); ++mesh) {
+    const MeshData& m = data.meshes[mesh];
+    meshBase_.push_back(uint32_t(triangles_.size()));
+    SurfaceHit probe;
+    probe.material = m.material;
+    const glm::vec3 albedo = scene_.bsdf(probe).params().diffuse;
+    const glm::vec3 le = data.materials[m.material].emission;
+    for (uint32_t t = 0; 3 * size_t(t) + 2 < m.indices.size(); ++t) {
+      const uint32_t* idx = &m.indices[3 * size_t(t)];
+      const RenderScene::TriangleFacts& facts = scene_.triangleFacts(mesh, t);
+      triangles_.push_back({m.positions[idx[0]], m.positions[idx[1]], m.positions[idx[2]], facts.normal, albedo,
+                            facts.coordinateScale});
+      emits_.push_back(!isBlack(le));
+    }
+  }
+}
+
+// The vector code below is compiled for AVX2 and FMA alone; unsupported() keeps other CPUs out.
+#pragma GCC push_options
+#pragma GCC target("avx2,fma")
+
+namespace {
+
+typedef float F8 __attribute__((vector_size(32)));
+typedef int32_t I8 __attribute__((vector_size(32)));
+constexpr float kInvPiF = std::numbers::inv_pi_v<float>;
+
+F8 splat(float x) { return F8{} + x; }
+F8 sqrt8(F8 x) { return F8(_mm256_sqrt_ps(__m256(x))); }
+F8 min8(F8 a, F8 b) { return a < b ? a : b; }
+F8 max8(F8 a, F8 b) { return a > b ? a : b; }
+F8 abs8(F8 a) { return F8(I8(a) & 0x7fffffff); }
+bool any(I8 m) { return _mm256_movemask_ps(__m256(m)) != 0; }
+int count(I8 m) { return __builtin_popcount(unsigned(_mm256_movemask_ps(__m256(m)))); }
+
+// fast::sinCosOctant, lane by lane (|x| <= pi / 4).
+void sinCosOctant(F8 x, F8& s, F8& c) {
+  const F8 z = x * x;
+  s = x + x * z * (-0.16666659411f + z * (0.0083324080842f + z * -0.00019543791327f));
+  c = 1.0f - 0.5f * z + z * z * (0.041666646866f + z * (-0.0013887367487f + z * 2.4438448729e-05f));
+}
+
+// offsetRayOrigin (accel.cpp), eight points at once; n is the side to leave by.
+void offsetRayOrigins(F8& px, F8& py, F8& pz, F8 nx, F8 ny, F8 nz, F8 coordinateScale) {
+  const F8 scale = (coordinateScale > 0.0f) & (coordinateScale < INFINITY) ? coordinateScale : splat(1.0f);
+  const F8 kOrigin = scale / 32.0f, kFloatScale = scale / 65536.0f;
+  const auto offset = [&](F8 p, F8 n) {
+    const I8 step = __builtin_convertvector(256.0f * n, I8);
+    const I8 negative = p < 0.0f;
+    const I8 bits = I8(p) + ((step ^ negative) - negative);
+    const I8 nearZero = F8(I8(p) & 0x7fffffff) < kOrigin;
+    return nearZero ? p + kFloatScale * n : F8(bits);
+  };
+  px = offset(px, nx), py = offset(py, ny), pz = offset(pz, nz);
+}
+
+}  // namespace
+
+class PathLanes::Batch {
+ public:
+  Batch(const PathLanes& lanes, const Camera& camera, uint64_t seed, uint64_t pass, int x0, int y0, int x1, int y1,
+        Film& film, PathStats& stats, uint64_t& discarded)
+      : lanes_(lanes), scene_(lanes.scene_), emitters_(lanes.scene_.emitters()), guide_(lanes.tracer_.emitterGuide()),
+        settings_(lanes.tracer_.settings()), camera_(camera), seed_(seed), pass_(pass), x0_(x0), y0_(y0), x1_(x1),
+        film_(film), stats_(stats), discarded_(discarded), pixels_(uint32_t(x1 - x0) * uint32_t(y1 - y0)) {}
+
+  void run() {
+    for (int k = 0; k < kLanes; ++k) start(k);
+    while (any(alive_)) {
+      bounce();
+      for (int k = 0; k < kLanes; ++k)
+        if (!alive_[k] && started_[k]) {
+          finish(k);
+          start(k);
+        }
+    }
+  }
+
+ private:
+  // Lane k takes the tile's next pixel, if any is left.
+  void start(int k) {
+    started_[k] = false;
+    if (next_ >= pixels_) return;
+    const uint32_t i = next_++;
+    const int width = x1_ - x0_;
+    x_[k] = x0_ + int(i % uint32_t(width)), y_[k] = y0_ + int(i / uint32_t(width));
+    const uint64_t pixel = uint64_t(y_[k]) * uint64_t(camera_.width()) + uint64_t(x_[k]);
+    PixelSampler& sampler = samplers_[k].emplace(seed_, pixel, pass_, true);
+    const Ray ray = camera_.generateRay(glm::vec2(float(x_[k]), float(y_[k])) + sampler.cameraJitter());
+    ox_[k] = ray.origin.x, oy_[k] = ray.origin.y, oz_[k] = ray.origin.z;
+    dx_[k] = ray.direction.x, dy_[k] = ray.direction.y, dz_[k] = ray.direction.z;
+    tMax_[k] = ray.tMax;
+    br_[k] = bg_[k] = bb_[k] = 1.0f;
+    L_[k] = glm::vec3(0.0f);
+    depth_[k] = 0;
+    prevPdf_[k] = 0.0f;
+    alive_[k] = -1;
+    started_[k] = true;
+  }
+
+  void finish(int k) {
+    started_[k] = false;
+    if (!isFiniteNonNegative(L_[k])) {
+      ++discarded_;
+      return;
+    }
+    film_.addSample(x_[k], y_[k], L_[k]);
+  }
+
+  void end(I8 lanes) { alive_ &= ~lanes; }
+  glm::vec3 beta(int k) const { return {br_[k], bg_[k], bb_[k]}; }
+
+  // One vertex of every live lane: radiance()'s loop body for BSDF sampling without window or joins.
+  void bounce() {
+    const RTCScene handle = scene_.accel().handle();
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    alignas(32) int valid[kLanes];
+    alignas(32) RTCRayHit8 rh;
+    for (int k = 0; k < kLanes; ++k) {
+      valid[k] = alive_[k];
+      rh.ray.org_x[k] = ox_[k], rh.ray.org_y[k] = oy_[k], rh.ray.org_z[k] = oz_[k];
+      rh.ray.dir_x[k] = dx_[k], rh.ray.dir_y[k] = dy_[k], rh.ray.dir_z[k] = dz_[k];
+      rh.ray.tnear[k] = 0.0f, rh.ray.tfar[k] = tMax_[k], rh.ray.time[k] = 0.0f;
+      rh.ray.mask[k] = ~0u, rh.ray.id[k] = 0, rh.ray.flags[k] = 0;
+      rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID, rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect8(valid, handle, &context, &rh);
+    stats_.rays += uint64_t(count(alive_));
+
+    // The hits, lane by lane: position, the normal facing the ray, the triangle's facts.
+    F8 px{}, py{}, pz{}, nx{}, ny{}, nz{}, ar{}, ag{}, ab{}, scale{};
+    I8 hitEmitter{};
+    for (int k = 0; k < kLanes; ++k) {
+      if (!alive_[k]) continue;
+      if (rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) {
+        escape(k);
+        alive_[k] = 0;
+        continue;
+      }
+      const uint32_t g = lanes_.meshBase_[rh.hit.geomID[k]] + rh.hit.primID[k];
+      const Triangle& t = lanes_.triangles_[g];
+      const float u = rh.hit.u[k], v = rh.hit.v[k], b0 = 1.0f - u - v;
+      const glm::vec3 p = t.p0 * b0 + t.p1 * u + t.p2 * v;
+      const glm::vec3 d(dx_[k], dy_[k], dz_[k]);
+      glm::vec3 n = t.normal;
+      if (n == glm::vec3(0.0f)) n = -d;  // degenerate, as surface() does
+      const bool front = glm::dot(n, d) < 0.0f;
+      if (!front) n = -n;
+      px[k] = p.x, py[k] = p.y, pz[k] = p.z, nx[k] = n.x, ny[k] = n.y, nz[k] = n.z;
+      ar[k] = t.albedo.x, ag[k] = t.albedo.y, ab[k] = t.albedo.z, scale[k] = t.coordinateScale;
+      frontFace_[k] = front;
+      if (lanes_.emits_[g]) hitEmitter[k] = -1;
+    }
+    for (int k = 0; k < kLanes; ++k)
+      if (hitEmitter[k]) emitterHit(k, hitSurface(k, px, py, pz, nx, ny, nz, scale, rh.hit.geomID[k], rh.hit.primID[k]));
+    end(depth_ + 1 > settings_.maxDepth);
+    if (!any(alive_)) return;
+
+    // The vertex's numbers, from each lane's sampler (the same slots as radiance()).
+    std::optional<VertexSamples> numbers[kLanes];
+    F8 uDir0 = splat(0.5f), uDir1 = splat(0.5f);
+    for (int k = 0; k < kLanes; ++k)
+      if (alive_[k]) {
+        const glm::vec2 u = numbers[k].emplace(*samplers_[k], depth_[k]).bsdfDirection();
+        uDir0[k] = u.x, uDir1[k] = u.y;
+      }
+
+    // Next-event estimation, lane by lane; the shadow rays as one packet.
+    alignas(32) RTCRay8 shadow;
+    alignas(32) int tested[kLanes];
+    glm::vec3 contribution[kLanes];
+    float arrival[kLanes];
+    uint32_t slot[kLanes];
+    int shadows = 0;
+    for (int k = 0; k < kLanes; ++k) {
+      tested[k] = 0;
+      if (!alive_[k]) continue;
+      const glm::vec3 p(px[k], py[k], pz[k]), n(nx[k], ny[k], nz[k]);
+      VertexSamples& u = *numbers[k];
+      const auto lightChoice = [&] { return u.lightChoice(); };
+      const auto ls = guide_ ? guide_->sample(p, u.lightPoint(), lightChoice) : emitters_.sampleStratified(p, u.lightPoint(), lightChoice);
+      if (!ls) continue;
+      // The Lambertian lobe's eval and pdf (Bsdf::eval, Bsdf::pdf), its frame's normal n.
+      const float cosReceiver = glm::dot(ls->wi, n), cosOutgoing = -(dx_[k] * n.x + dy_[k] * n.y + dz_[k] * n.z);
+      if (!(cosReceiver > 0.0f) || cosOutgoing <= 0.0f) continue;
+      const glm::vec3 f = glm::vec3(ar[k], ag[k], ab[k]) * kInvPiF * cosReceiver;
+      if (isBlack(f)) continue;
+      ++stats_.rays;
+      if (guide_) guide_->attempted(ls->guideSlot);
+      SurfaceHit from;
+      from.position = p, from.geometricNormal = n, from.coordinateScale = scale[k];
+      const Ray r = spawnShadowRay(from, ls->wi, ls->distance);
+      shadow.org_x[k] = r.origin.x, shadow.org_y[k] = r.origin.y, shadow.org_z[k] = r.origin.z;
+      shadow.dir_x[k] = r.direction.x, shadow.dir_y[k] = r.direction.y, shadow.dir_z[k] = r.direction.z;
+      shadow.tnear[k] = 0.0f, shadow.tfar[k] = r.tMax, shadow.time[k] = 0.0f;
+      shadow.mask[k] = ~0u, shadow.id[k] = 0, shadow.flags[k] = 0;
+      const float w = ls->delta ? 1.0f : powerHeuristic(ls->pdf, cosineHemispherePdf(cosReceiver));
+      contribution[k] = f * ls->radiance * (w / ls->pdf);
+      arrival[k] = luminance(ls->radiance) * cosReceiver / ls->pdf;
+      slot[k] = ls->guideSlot;
+      tested[k] = -1;
+      ++shadows;
+    }
+    if (shadows > 0) {
+      rtcOccluded8(tested, handle, &context, &shadow);
+      for (int k = 0; k < kLanes; ++k) {
+        if (!tested[k] || !(shadow.tfar[k] >= 0.0f)) continue;  // Embree sets tfar to -inf on a hit
+        if (guide_) guide_->arrived(slot[k], arrival[k]);
+        L_[k] += beta(k) * contribution[k];
+      }
+    }
+
+    // The continuation: Bsdf::sampleLambertian (sampleCosineHemisphere in the frame of n) in lanes.
+    const F8 u0 = min8(uDir0, splat(0x1.fffffep-1f));
+    const F8 ox = 2.0f * u0 - 1.0f, oy = 2.0f * uDir1 - 1.0f;
+    const I8 centre = (ox == 0.0f) & (oy == 0.0f);
+    const I8 aboutX = abs8(ox) > abs8(oy);
+    const F8 radius = aboutX ? ox : oy;
+    const F8 safeRadius = centre ? splat(1.0f) : radius;
+    F8 s, c;
+    sinCosOctant(0.25f * std::numbers::pi_v<float> * ((aboutX ? oy : ox) / safeRadius), s, c);
+    const F8 lx = centre ? F8{} : radius * (aboutX ? c : s), ly = centre ? F8{} : radius * (aboutX ? s : c);
+    const F8 z = sqrt8(max8(F8{}, 1.0f - lx * lx - ly * ly));
+    const I8 sampled = alive_ & (z > 0.0f) & (dx_ * nx + dy_ * ny + dz_ * nz < 0.0f);  // and wo above the lobe
+    stats_.bsdfSamples += uint64_t(count(sampled));
+    // Frame::fromNormal (Duff et al.): the sign is copysign(1, n.z).
+    const F8 sign = F8((I8(nz) & int32_t(0x80000000)) | I8(splat(1.0f)));
+    const F8 a = -1.0f / (sign + nz), b = nx * ny * a;
+    const F8 sx = 1.0f + sign * nx * nx * a, sy = sign * b, sz = -sign * nx;
+    const F8 tx = b, ty = sign + ny * ny * a, tz = -ny;
+    F8 wx = sx * lx + tx * ly + nx * z, wy = sy * lx + ty * ly + ny * z, wz = sz * lx + tz * ly + nz * z;
+    const F8 inverseLength = 1.0f / sqrt8(wx * wx + wy * wy + wz * wz);
+    wx *= inverseLength, wy *= inverseLength, wz *= inverseLength;
+    const I8 reflects = (max8(ar, max8(ag, ab)) > 0.0f) & (wx * nx + wy * ny + wz * nz > 0.0f);
+    br_ *= ar, bg_ *= ag, bb_ *= ab;
+    const F8 largest = max8(br_, max8(bg_, bb_));
+    const I8 finite = (br_ >= 0.0f) & (bg_ >= 0.0f) & (bb_ >= 0.0f) & (largest < INFINITY);
+    end(alive_ & ~(sampled & reflects & finite));
+
+    // Russian roulette on the throughput, by radiance()'s rule.
+    const I8 rolls = alive_ & (depth_ + 1 >= settings_.rrStartDepth);
+    if (any(rolls)) {
+      const F8 survive = min8(splat(1.0f), settings_.roulette == RouletteRule::Throughput ? largest : sqrt8(largest));
+      I8 killed{};
+      for (int k = 0; k < kLanes; ++k)
+        if (rolls[k] && numbers[k]->roulette() >= survive[k]) killed[k] = -1;
+      const F8 divisor = rolls ? survive : splat(1.0f);
+      br_ /= divisor, bg_ /= divisor, bb_ /= divisor;
+      end(killed);
+    }
+
+    // spawnRay: leave by the side the direction points to (the normal's: it was tested above).
+    prevX_ = px, prevY_ = py, prevZ_ = pz;
+    prevPdf_ = alive_ ? z * kInvPiF : prevPdf_;
+    offsetRayOrigins(px, py, pz, nx, ny, nz, scale);
+    ox_ = alive_ ? px : ox_, oy_ = alive_ ? py : oy_, oz_ = alive_ ? pz : oz_;
+    dx_ = alive_ ? wx : dx_, dy_ = alive_ ? wy : dy_, dz_ = alive_ ? wz : dz_;
+    tMax_ = alive_ ? splat(INFINITY) : tMax_;
+    depth_ += alive_ & 1;
+  }
+
+  // The SurfaceHit of lane k's hit, for the scalar calls that take one.
+  SurfaceHit hitSurface(int k, F8 px, F8 py, F8 pz, F8 nx, F8 ny, F8 nz, F8 scale, uint32_t mesh, uint32_t triangle) const {
+    SurfaceHit s;
+    s.position = glm::vec3(px[k], py[k], pz[k]);
+    s.geometricNormal = s.shadingNormal = glm::vec3(nx[k], ny[k], nz[k]);
+    s.mesh = mesh, s.triangle = triangle, s.material = scene_.data().meshes[mesh].material;
+    s.frontFace = frontFace_[k];
+    s.coordinateScale = scale[k];
+    return s;
+  }
+
+  // An emitter hit, weighed against next-event estimation from the previous vertex.
+  void emitterHit(int k, const SurfaceHit& surface) {
+    const glm::vec3 le = emitters_.emitted(surface, -glm::vec3(dx_[k], dy_[k], dz_[k]));
+    if (isBlack(le)) return;
+    float w = 1.0f;
+    if (depth_[k] > 0) {
+      const glm::vec3 previous(prevX_[k], prevY_[k], prevZ_[k]);
+      w = powerHeuristic(prevPdf_[k], guide_ ? guide_->pdf(previous, surface) : emitters_.pdfTriangle(previous, surface));
+    }
+    L_[k] += beta(k) * le * w;
+  }
+
+  // Lane k's ray left the scene: the sky, weighed against next-event estimation of the sky.
+  void escape(int k) {
+    if (!emitters_.hasSky()) return;
+    float w = 1.0f;
+    if (depth_[k] > 0) {
+      const glm::vec3 previous(prevX_[k], prevY_[k], prevZ_[k]), d(dx_[k], dy_[k], dz_[k]);
+      w = powerHeuristic(prevPdf_[k], guide_ ? guide_->pdfSky(previous, d) : emitters_.pdfSky(d));
+    }
+    L_[k] += beta(k) * emitters_.sky() * w;
+  }
+
+  const PathLanes& lanes_;
+  const RenderScene& scene_;
+  const EmitterSet& emitters_;
+  const EmitterGuide* guide_;
+  const PathTracerSettings& settings_;
+  const Camera& camera_;
+  uint64_t seed_, pass_;
+  int x0_, y0_, x1_;
+  Film& film_;
+  PathStats& stats_;
+  uint64_t& discarded_;
+  uint32_t next_ = 0, pixels_;
+
+  // Per lane: its sample, and its path's state (vectors where the arithmetic is shared).
+  std::optional<PixelSampler> samplers_[kLanes];
+  int x_[kLanes] = {}, y_[kLanes] = {};
+  bool started_[kLanes] = {}, frontFace_[kLanes] = {};
+  glm::vec3 L_[kLanes];
+  F8 ox_{}, oy_{}, oz_{}, dx_{}, dy_{}, dz_{}, tMax_{}, br_{}, bg_{}, bb_{}, prevPdf_{}, prevX_{}, prevY_{}, prevZ_{};
+  I8 depth_{}, alive_{};
+};
+
+void PathLanes::renderTile(const Camera& camera, uint64_t seed, uint64_t pass, int x0, int y0, int x1, int y1, Film& film,
+                           PathStats& stats, uint64_t& discarded) const {
+  Batch(*this, camera, seed, pass, x0, y0, x1, y1, film, stats, discarded).run();
+}
+
+#pragma GCC pop_options
+
+}  // namespace vpl
