@@ -216,11 +216,13 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
   if (!state.field) {
     const Camera small(request.camera, std::max(1, w / kQuickDivisor), std::max(1, h / kQuickDivisor));
     if (!state.quick) state.quick = std::make_unique<Film>(small.width(), small.height());
-    const TileRenderer renderer(small, settings_.seed, pathTracerShader(tracer_), settings_.stratifiedSampler);
+    std::optional<TileRenderer> renderer;
+    std::optional<PathLanes> lanes;
+    emplaceBsdfRenderer(renderer, lanes, small, settings_.seed, tracer_, settings_.stratifiedSampler);
     do {
       // The first quick pass always completes: a restart never leaves the window without a frame.
       const uint64_t pass = state.quickPasses++;
-      renderer.renderPass(*state.quick, pass, pass > 0 ? &cancel_ : nullptr);
+      renderer->renderPass(*state.quick, pass, pass > 0 ? &cancel_ : nullptr);
       if (cancelled()) return;
       publish(upscaleNearest(state.quick->resolve(), w, h), SessionStage::Quick, int(state.quickPasses));
       if (state.quickPasses == 1) {
@@ -353,7 +355,16 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
     return *t;
   };
   std::optional<TileRenderer> renderer;
-  renderer.emplace(camera, settings_.seed, pathTracerShader(refineTracer(), continuation), settings_.stratifiedSampler);
+  std::optional<PathLanes> lanes;  // brdf's, where they apply
+  const auto emplaceRenderer = [&] {
+    if (isGuided(request.mode)) {
+      renderer.reset();  // its shader holds the old tracer
+      renderer.emplace(camera, settings_.seed, pathTracerShader(refineTracer(), continuation), settings_.stratifiedSampler);
+    } else {
+      emplaceBsdfRenderer(renderer, lanes, camera, settings_.seed, refineTracer(), settings_.stratifiedSampler);
+    }
+  };
+  emplaceRenderer();
   const auto noteWindow = [&] {
     std::lock_guard lock(mutex_);
     stats_.rouletteWindow = rule == RouletteRule::Vpl || (rule == RouletteRule::Auto && mine.window.on());
@@ -408,8 +419,7 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
     }
     if (rule == RouletteRule::Auto && !mine.window.on() && WindowSwitch::updateDue(uint64_t(mine.complete)) &&
         mine.window.update(*mine.film)) {
-      renderer.reset();
-      renderer.emplace(camera, settings_.seed, pathTracerShader(refineTracer(), continuation), settings_.stratifiedSampler);
+      emplaceRenderer();
       noteWindow();
     }
     if (mine.complete >= settings_.handoverSpp || preview.complete == 0)

@@ -147,21 +147,16 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
       const ContinuationFactory continuation = guidedContinuations(guide, mode, learners->logs());
       shaderFor = [continuation](const PathTracer& t) { return pathTracerShader(t, continuation); };
     }
-  } else {
-    shaderFor = [](const PathTracer& t) { return pathTracerShader(t); };
   }
   std::optional<TileRenderer> renderer;
   std::optional<PathLanes> lanes;
-  // `brdf` through the lanes wherever they model the tracer exactly (path_lanes.h).
   const auto makeRenderer = [&] {
-    renderer.reset();  // its shader or lanes hold the old tracer
-    lanes.reset();
-    if (settings.mode == SamplingMode::Brdf && settings.stratifiedSampler && PathLanes::unsupported(*tracer).empty()) {
-      renderer.emplace(camera, settings.seed, lanes.emplace(*tracer));
-    } else {
-      renderer.emplace(camera, settings.seed, shaderFor(*tracer), settings.stratifiedSampler);
+    if (settings.mode == SamplingMode::Brdf) {
+      result.lanes = emplaceBsdfRenderer(renderer, lanes, camera, settings.seed, *tracer, settings.stratifiedSampler);
+      return;
     }
-    result.lanes = lanes ? PathLanes::kLanes : 1;
+    renderer.reset();  // its shader holds the old tracer
+    renderer.emplace(camera, settings.seed, shaderFor(*tracer), settings.stratifiedSampler);
   };
   makeRenderer();
   Film film(settings.width, settings.height);

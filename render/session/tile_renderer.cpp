@@ -28,6 +28,18 @@ TileRenderer::TileRenderer(const Camera& camera, uint64_t seed, PixelShaderFacto
     : camera_(camera), seed_(seed), shader_(std::move(shader)), stratified_(stratified),
       tilesX_((camera.width() + kTileSize - 1) / kTileSize), tilesY_((camera.height() + kTileSize - 1) / kTileSize) {}
 
+int emplaceBsdfRenderer(std::optional<TileRenderer>& renderer, std::optional<PathLanes>& lanes, const Camera& camera,
+                        uint64_t seed, const PathTracer& tracer, bool stratified) {
+  renderer.reset();  // it may read the lanes
+  lanes.reset();
+  if (stratified && PathLanes::unsupported(tracer).empty()) {
+    renderer.emplace(camera, seed, lanes.emplace(tracer));
+    return PathLanes::kLanes;
+  }
+  renderer.emplace(camera, seed, pathTracerShader(tracer), stratified);
+  return 1;
+}
+
 TileRenderer::TileRenderer(const Camera& camera, uint64_t seed, const PathLanes& lanes)
     : TileRenderer(camera, seed, PixelShaderFactory{}, true) {
   lanes_ = &lanes;

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include "render/film/film.h"
 #include "render/integrator/path_lanes.h"
 #include "render/integrator/path_tracer.h"
@@ -49,6 +50,13 @@ PixelShaderFactory pathTracerShader(const PathTracer& tracer, ContinuationFactor
 // The guided modes' continuations: one per tile and pass, each writing its tile's logs of the
 // learners (a learned BSDF probability for mis, learned guides; either may be absent).
 ContinuationFactory guidedContinuations(const GuideField& guide, SamplingMode mode, const GuideLearners& learners);
+
+class TileRenderer;
+// `brdf`'s renderer of `tracer`'s samples: through PathLanes where the lanes model the tracer
+// (path_lanes.h), else radiance() pixel by pixel. Replaces both; `lanes` must live as long as `renderer`.
+// Returns the paths traced at once (PathLanes::kLanes or 1).
+int emplaceBsdfRenderer(std::optional<TileRenderer>& renderer, std::optional<PathLanes>& lanes, const Camera& camera,
+                        uint64_t seed, const PathTracer& tracer, bool stratified);
 
 class TileRenderer {
  public:

@@ -1,0 +1,142 @@
+// brdf's eight-lane estimator (render/integrator/path_lanes.h): the same samples as radiance(), an
+// analytic furnace, and the scenes it must leave to radiance().
+#include <cmath>
+#include "render/film/image_metrics.h"
+#include "render/integrator/path_lanes.h"
+#include "render/session/render_job.h"
+#include "tests/unit/scene_builders.h"
+#include "tests/unit/support.h"
+
+namespace vpl {
+namespace {
+
+bool cpuHasLanes() {
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+}
+
+RenderJobSettings brdf(int width, int height, int spp) {
+  RenderJobSettings s;
+  s.mode = SamplingMode::Brdf;
+  s.width = width;
+  s.height = height;
+  s.spp = spp;
+  s.seed = 3;
+  return s;
+}
+
+// Renders with the lanes and without; both must have taken the path they were asked to.
+std::pair<RenderJobResult, RenderJobResult> withAndWithout(RenderJobSettings s, const SceneData* data = nullptr) {
+  s.tracer.lanes = true;
+  RenderJobResult lanes = data ? runRenderJob(s, *data) : runRenderJob(s);
+  s.tracer.lanes = false;
+  RenderJobResult scalar = data ? runRenderJob(s, *data) : runRenderJob(s);
+  EXPECT_EQ(lanes.lanes, PathLanes::kLanes);
+  EXPECT_EQ(scalar.lanes, 1);
+  return {std::move(lanes), std::move(scalar)};
+}
+
+// The lanes draw the same numbers as radiance() and make the same decisions, so sample for sample
+// the images agree up to float rounding (an occasional roulette or grazing hit that rounds the other
+// way): far below the noise of any estimator that differs (a wrong MIS weight, continuation or
+// roulette moves whole pixels).
+TEST(PathLanes, CornellBoxSamplesAreRadiancesSamples) {
+  if (!cpuHasLanes()) GTEST_SKIP() << "this CPU has no AVX2 and FMA: the lanes never run";
+  RenderJobSettings s = brdf(48, 36, 8);
+  s.scenePath = test::sourceDir() + "/scenes/cornell_box.gltf";
+  s.tracer.roulette = RouletteRule::Sqrt;
+  const auto [lanes, scalar] = withAndWithout(s);
+  EXPECT_LT(relMse(lanes.image, scalar.image), 1e-8);
+  EXPECT_NEAR(double(lanes.rays), double(scalar.rays), 1e-4 * double(scalar.rays));
+  EXPECT_NEAR(double(lanes.bsdfSamples), double(scalar.bsdfSamples), 1e-4 * double(scalar.bsdfSamples));
+  EXPECT_EQ(lanes.samples, scalar.samples);
+  EXPECT_EQ(lanes.discarded, 0u);
+}
+
+// The parts of radiance() the Cornell box does not reach: the sky (escaped rays, its MIS weight),
+// punctual lights (no MIS), the throughput roulette rule, learned next-event estimation switched off.
+TEST(PathLanes, SkyPointLightAndThroughputRouletteAsRadiance) {
+  if (!cpuHasLanes()) GTEST_SKIP() << "this CPU has no AVX2 and FMA: the lanes never run";
+  SceneData scene;
+  scene.materials.push_back(test::lambertian(0.6f));
+  MeshData floor;
+  floor.positions = {{-4, 0, -4}, {4, 0, -4}, {4, 0, 4}, {-4, 0, 4}, {-0.5f, 0.2f, 0}, {0.5f, 0.2f, 0}, {0, 1.2f, 0}};
+  floor.indices = {0, 2, 1, 0, 3, 2, 4, 5, 6};
+  floor.material = 0;
+  scene.meshes.push_back(floor);
+  PunctualLight lamp;
+  lamp.position = glm::vec3(0.5f, 1.5f, 0.8f);
+  lamp.intensity = glm::vec3(3.0f, 2.5f, 2.0f);
+  scene.lights.push_back(lamp);
+  scene.boundsMin = glm::vec3(-4, 0, -4);
+  scene.boundsMax = glm::vec3(4, 1.2f, 4);
+  CameraData camera;
+  camera.eye = glm::vec3(0, 2.0f, 2.5f);
+  camera.target = glm::vec3(0, 0.2f, 0);
+  scene.camera = camera;
+  RenderJobSettings s = brdf(40, 30, 8);
+  s.scenePath = "floor, triangle, lamp and sky";
+  s.sky.explicitSky = true;
+  s.sky.radiance = glm::vec3(0.3f, 0.4f, 0.6f);
+  s.tracer.roulette = RouletteRule::Throughput;
+  s.tracer.rrStartDepth = 1;
+  s.tracer.learnLights = false;
+  const auto [lanes, scalar] = withAndWithout(s, &scene);
+  EXPECT_GT(meanRgb(scalar.image).z, 0.1);
+  EXPECT_GT(scalar.rays, 2 * scalar.samples);  // most samples reach the floor and bounce
+  EXPECT_LT(relMse(lanes.image, scalar.image), 1e-8);
+  EXPECT_NEAR(double(lanes.rays), double(scalar.rays), 1e-4 * double(scalar.rays));
+}
+
+// Against an answer of its own: inside a closed box of albedo rho whose walls all emit le, radiance is
+// le / (1 - rho) everywhere (to 32 segments, within rho^32).
+TEST(PathLanes, WhiteFurnaceConverges) {
+  if (!cpuHasLanes()) GTEST_SKIP() << "this CPU has no AVX2 and FMA: the lanes never run";
+  const float rho = 0.5f, le = 1.0f;
+  const SceneData furnace = test::furnaceScene(rho, le);
+  RenderJobSettings s = brdf(24, 24, 32);
+  s.scenePath = "furnace";
+  s.tracer.roulette = RouletteRule::Sqrt;
+  const RenderJobResult r = runRenderJob(s, furnace);
+  ASSERT_EQ(r.lanes, PathLanes::kLanes);
+  const double expected = le / (1.0 - rho);
+  EXPECT_NEAR(meanRgb(r.image).y, expected, 0.01 * expected);
+}
+
+// What the lanes do not model goes to radiance(), never through a wrong estimator.
+TEST(PathLanes, LeavesToRadianceWhatTheyDoNotModel) {
+  const auto reason = [](SceneData scene, bool lanes = true) {
+    const RenderScene rs(std::move(scene));
+    PathTracerSettings settings;
+    settings.lanes = lanes;
+    return PathLanes::unsupported(PathTracer(rs, settings));
+  };
+  const SceneData furnace = test::furnaceScene(0.5f, 1.0f);
+  if (cpuHasLanes()) {
+    EXPECT_EQ(reason(furnace), "");
+  } else {
+    EXPECT_EQ(reason(furnace), "the CPU has no AVX2 and FMA");
+    return;
+  }
+  EXPECT_EQ(reason(furnace, false), "--lanes off");
+  SceneData glossy = furnace;
+  glossy.materials[0].specularFactor = 1.0f;
+  EXPECT_EQ(reason(glossy), "a material with a specular lobe");
+  SceneData metal = furnace;
+  metal.materials[0].metallic = 1.0f;
+  EXPECT_EQ(reason(metal), "a material with a specular lobe");
+  SceneData masked = furnace;
+  masked.materials[0].alphaMode = AlphaMode::Mask;
+  EXPECT_EQ(reason(masked), "a material with alpha");
+  SceneData smooth = furnace;
+  for (const glm::vec3& p : smooth.meshes[0].positions) smooth.meshes[0].normals.push_back(-glm::normalize(p));
+  EXPECT_EQ(reason(smooth), "smooth shading normals");
+  SceneData flat = furnace;  // a quad's vertex normals along its face, either way: flat
+  flat.meshes[0].positions = {{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1}};
+  flat.meshes[0].indices = {0, 1, 2, 0, 2, 3};
+  flat.meshes[0].normals = {{0, 0, 1}, {0, 0, 1}, {0, 0, -1}, {0, 0, 1}};
+  EXPECT_EQ(reason(flat), "");
+}
+
+}  // namespace
+}  // namespace vpl
