@@ -9,6 +9,7 @@
 #include "render/core/color.h"
 #include "render/guide/emitter_guide.h"
 #include "render/sampling/pixel_sampler.h"
+#include "render/integrator/weight_window.h"
 #include "render/sampling/warps.h"
 
 namespace vpl {
@@ -17,7 +18,6 @@ std::string PathLanes::unsupported(const PathTracer& tracer) {
   if (!tracer.settings().lanes) return "--lanes off";
   __builtin_cpu_init();
   if (!__builtin_cpu_supports("avx2") || !__builtin_cpu_supports("fma")) return "the CPU has no AVX2 and FMA";
-  if (tracer.usesWeightWindow()) return "the VPL weight window";
   if (tracer.joinsLightVertices()) return "VPL connections";
   const RenderScene& scene = tracer.scene();
   const SceneData& data = scene.data();
@@ -116,6 +116,11 @@ class PathLanes::Batch {
       bounce();
       for (int k = 0; k < kLanes; ++k)
         if (!alive_[k] && started_[k]) {
+          if (!pending_[k].empty()) {  // the sample's next branch, in radiance()'s order
+            resume(k, pending_[k].back());
+            pending_[k].pop_back();
+            continue;
+          }
           finish(k);
           start(k);
         }
@@ -142,6 +147,30 @@ class PathLanes::Batch {
     prevPdf_[k] = 0.0f;
     alive_[k] = -1;
     started_[k] = true;
+    branchesLeft_[k] = settings_.window.maxBranches - 1;
+    nextBranchId_[k] = 1;
+  }
+
+  // A split's branch waiting for its lane (PathTracer::radiance's Branch, without joins' sums).
+  struct Branch {
+    Ray ray;
+    glm::vec3 beta{0.0f}, previousPosition{0.0f};
+    float previousPdf = 0.0f;
+    int depth = 0;
+    PixelSampler sampler;
+  };
+
+  // Lane k goes on with one of its sample's branches.
+  void resume(int k, const Branch& b) {
+    samplers_[k].emplace(b.sampler);
+    ox_[k] = b.ray.origin.x, oy_[k] = b.ray.origin.y, oz_[k] = b.ray.origin.z;
+    dx_[k] = b.ray.direction.x, dy_[k] = b.ray.direction.y, dz_[k] = b.ray.direction.z;
+    tMax_[k] = b.ray.tMax;
+    br_[k] = b.beta.x, bg_[k] = b.beta.y, bb_[k] = b.beta.z;
+    prevX_[k] = b.previousPosition.x, prevY_[k] = b.previousPosition.y, prevZ_[k] = b.previousPosition.z;
+    prevPdf_[k] = b.previousPdf;
+    depth_[k] = b.depth;
+    alive_[k] = -1;
   }
 
   void finish(int k) {
@@ -198,17 +227,47 @@ class PathLanes::Batch {
       frontFace_[k] = front;
       if (lanes_.emits_[g]) hitEmitter[k] = -1;
     }
+    float emitted[kLanes] = {};
     for (int k = 0; k < kLanes; ++k)
-      if (hitEmitter[k]) emitterHit(k, hitSurface(k, px, py, pz, nx, ny, nz, scale, rh.hit.geomID[k], rh.hit.primID[k]));
+      if (hitEmitter[k]) emitted[k] = emitterHit(k, hitSurface(k, px, py, pz, nx, ny, nz, scale, rh.hit.geomID[k], rh.hit.primID[k]));
     end(depth_ + 1 > settings_.maxDepth);
     if (!any(alive_)) return;
 
     // The vertex's numbers, from each lane's sampler (the same slots as radiance()).
     std::optional<VertexSamples> numbers[kLanes];
+    for (int k = 0; k < kLanes; ++k)
+      if (alive_[k]) numbers[k].emplace(*samplers_[k], depth_[k]);
+
+    // The VPL weight window: roulette for paths worth little against the pixel, splitting for those
+    // worth much; the camera ray's hit sets the pixel's estimate.
+    I8 windowed{};
+    int split[kLanes];
+    std::fill(split, split + kLanes, 1);
+    if (lanes_.tracer_.usesWeightWindow())
+      for (int k = 0; k < kLanes; ++k) {
+        if (!alive_[k]) continue;
+        const float predicted = lanes_.tracer_.predictedRadiance(glm::vec3(px[k], py[k], pz[k]), glm::vec3(nx[k], ny[k], nz[k]),
+                                                                 glm::vec3(ar[k], ag[k], ab[k]));
+        if (depth_[k] == 0) {
+          pixelEstimate_[k] = emitted[k] + predicted;
+        } else if (pixelEstimate_[k] > 0.0f && predicted > 0.0f) {
+          windowed[k] = -1;
+          const WindowDecision d = weightWindow(luminance(beta(k)) * predicted / pixelEstimate_[k], settings_.window);
+          if (d.survival < 1.0f) {
+            if (numbers[k]->roulette() >= d.survival) {
+              alive_[k] = 0;
+              continue;
+            }
+            br_[k] /= d.survival, bg_[k] /= d.survival, bb_[k] /= d.survival;
+          }
+          split[k] = std::min(d.split, branchesLeft_[k] + 1);
+        }
+      }
+    if (!any(alive_)) return;
     F8 uDir0 = splat(0.5f), uDir1 = splat(0.5f);
     for (int k = 0; k < kLanes; ++k)
       if (alive_[k]) {
-        const glm::vec2 u = numbers[k].emplace(*samplers_[k], depth_[k]).bsdfDirection();
+        const glm::vec2 u = numbers[k]->bsdfDirection();
         uDir0[k] = u.x, uDir1[k] = u.y;
       }
 
@@ -257,6 +316,10 @@ class PathLanes::Batch {
       }
     }
 
+    // A split's other branches, each with its own numbers, traced after this path in radiance()'s order.
+    for (int k = 0; k < kLanes; ++k)
+      if (alive_[k] && split[k] > 1) branch(k, split[k], hitSurface(k, px, py, pz, nx, ny, nz, scale, rh.hit.geomID[k], rh.hit.primID[k]));
+
     // The continuation: Bsdf::sampleLambertian (sampleCosineHemisphere in the frame of n) in lanes.
     const F8 u0 = min8(uDir0, splat(0x1.fffffep-1f));
     const F8 ox = 2.0f * u0 - 1.0f, oy = 2.0f * uDir1 - 1.0f;
@@ -285,7 +348,7 @@ class PathLanes::Batch {
     end(alive_ & ~(sampled & reflects & finite));
 
     // Russian roulette on the throughput, by radiance()'s rule.
-    const I8 rolls = alive_ & (depth_ + 1 >= settings_.rrStartDepth);
+    const I8 rolls = alive_ & ~windowed & (depth_ + 1 >= settings_.rrStartDepth);
     if (any(rolls)) {
       const F8 survive = min8(splat(1.0f), settings_.roulette == RouletteRule::Throughput ? largest : sqrt8(largest));
       I8 killed{};
@@ -317,16 +380,43 @@ class PathLanes::Batch {
     return s;
   }
 
-  // An emitter hit, weighed against next-event estimation from the previous vertex.
-  void emitterHit(int k, const SurfaceHit& surface) {
+  // An emitter hit, weighed against next-event estimation from the previous vertex; returns what the
+  // emitter sends (luminance), before the weight.
+  float emitterHit(int k, const SurfaceHit& surface) {
     const glm::vec3 le = emitters_.emitted(surface, -glm::vec3(dx_[k], dy_[k], dz_[k]));
-    if (isBlack(le)) return;
+    if (isBlack(le)) return 0.0f;
     float w = 1.0f;
     if (depth_[k] > 0) {
       const glm::vec3 previous(prevX_[k], prevY_[k], prevZ_[k]);
       w = powerHeuristic(prevPdf_[k], guide_ ? guide_->pdf(previous, surface) : emitters_.pdfTriangle(previous, surface));
     }
     L_[k] += beta(k) * le * w;
+    return luminance(le);
+  }
+
+  // Splits lane k's path at `surface` into `split` branches: the split - 1 others are drawn and kept
+  // for later (sampleContinuation of radiance(), with the branch's own numbers), the lane's own weight
+  // shrinks to its share.
+  void branch(int k, int split, const SurfaceHit& surface) {
+    const glm::vec3 wo(-dx_[k], -dy_[k], -dz_[k]);
+    const Bsdf bsdf = scene_.bsdf(surface, wo);
+    const glm::vec3 share = beta(k) / float(split);
+    for (int b = 1; b < split; ++b) {
+      Branch next{Ray{}, glm::vec3(0.0f), surface.position, 0.0f, depth_[k] + 1, samplers_[k]->branch(nextBranchId_[k]++)};
+      VertexSamples u(next.sampler, depth_[k]);
+      const auto s = bsdf.sample(wo, u.bsdfDirection());
+      if (!s || !(s->pdf > 0.0f)) continue;
+      ++stats_.bsdfSamples;
+      if (isBlack(s->weight) || !(glm::dot(s->wi, surface.geometricNormal) > 0.0f)) continue;
+      next.beta = share * s->weight;
+      if (!isFiniteNonNegative(next.beta)) continue;
+      next.ray = spawnRay(surface, s->wi);
+      next.previousPdf = s->pdf;
+      pending_[k].push_back(next);
+      --branchesLeft_[k];
+      ++stats_.branches;
+    }
+    br_[k] = share.x, bg_[k] = share.y, bb_[k] = share.z;
   }
 
   // Lane k's ray left the scene: the sky, weighed against next-event estimation of the sky.
@@ -358,6 +448,10 @@ class PathLanes::Batch {
   int x_[kLanes] = {}, y_[kLanes] = {};
   bool started_[kLanes] = {}, frontFace_[kLanes] = {};
   glm::vec3 L_[kLanes];
+  float pixelEstimate_[kLanes] = {};  // the weight window's reference, set at the camera ray's hit
+  int branchesLeft_[kLanes] = {};
+  uint32_t nextBranchId_[kLanes] = {};
+  std::vector<Branch> pending_[kLanes];  // the sample's branches still to trace, last made first
   F8 ox_{}, oy_{}, oz_{}, dx_{}, dy_{}, dz_{}, tMax_{}, br_{}, bg_{}, bb_{}, prevPdf_{}, prevX_{}, prevY_{}, prevZ_{};
   I8 depth_{}, alive_{};
 };

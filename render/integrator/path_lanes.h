@@ -7,8 +7,12 @@
 // estimation (EmitterSet or the learned EmitterGuide, the same calls), emitter hits and the sky.
 // So each sample is radiance()'s, with the same numbers, up to float rounding.
 //
+// The VPL weight window's roulette and splitting are radiance()'s too: a lane keeps its sample's branches
+// and traces them after the sample's first path, in radiance()'s order, so each branch gets the same
+// numbers and the same share of the sample's branch budget.
+//
 // Only where the vector form is the whole model (unsupported() says why not, and the caller keeps
-// radiance()): BSDF sampling, no VPL weight window or connections, every material Lambertian,
+// radiance()): BSDF sampling, no VPL connections, every material Lambertian,
 // untextured and opaque, every triangle flat-shaded (vertex normals, if any, along its own), and a
 // CPU with AVX2 and FMA (this file's vector code is compiled for them alone, and chosen at run time).
 // `--lanes off` keeps radiance() everywhere: the ablation, and what the tests compare against.

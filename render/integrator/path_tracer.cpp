@@ -77,10 +77,8 @@ PathTracer::PathTracer(const RenderScene& scene, const PathTracerSettings& setti
   if (windowRule && irradiance && !irradiance->empty()) irradiance_ = irradiance;
 }
 
-float PathTracer::predictedRadiance(const SurfaceHit& surface, const Bsdf& bsdf) const {
-  // A diffuse reflector of the BSDF's albedo at normal incidence: rough, but only ever a ratio's input.
-  const glm::vec3 albedo = glm::min(bsdf.params().diffuse + bsdf.params().f0, glm::vec3(1.0f));
-  return luminance(albedo * irradiance_->irradiance(surface.position, surface.geometricNormal)) * kInvPi;
+float PathTracer::predictedRadiance(const glm::vec3& position, const glm::vec3& normal, const glm::vec3& reflectance) const {
+  return luminance(glm::min(reflectance, glm::vec3(1.0f)) * irradiance_->irradiance(position, normal)) * kInvPi;
 }
 
 // A path waiting to be traced: a split vertex's other branches, each with its own numbers.

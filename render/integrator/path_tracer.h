@@ -135,6 +135,9 @@ class PathTracer {
   // What radiance() uses beside the BSDF and the emitters (null when not in use).
   const EmitterGuide* emitterGuide() const { return emitterGuide_; }
   bool usesWeightWindow() const { return irradiance_ != nullptr; }
+  // With the weight window: the radiance a diffuse reflector of `reflectance` at normal incidence
+  // sends back from `position` (normal `normal`), as the VPLs predict it (luminance).
+  float predictedRadiance(const glm::vec3& position, const glm::vec3& normal, const glm::vec3& reflectance) const;
   bool joinsLightVertices() const { return connections_ != nullptr; }
 
  private:
@@ -145,7 +148,10 @@ class PathTracer {
   };
   static constexpr int kNoCounterfactual = -100;  // a join depth limit that stands for none
   // Radiance reflected at a vertex towards the path, as the VPLs predict it (luminance).
-  float predictedRadiance(const SurfaceHit& surface, const Bsdf& bsdf) const;
+  float predictedRadiance(const SurfaceHit& surface, const Bsdf& bsdf) const {
+    // A diffuse reflector of the BSDF's albedo at normal incidence: rough, but only ever a ratio's input.
+    return predictedRadiance(surface.position, surface.geometricNormal, bsdf.params().diffuse + bsdf.params().f0);
+  }
   // MIS weights of an emitter hit and of a next-event sample: against each other alone, or with
   // connections against every join that makes the same path.
   // Next-event estimation's solid-angle density at p of an emitter hit's point.

@@ -88,6 +88,21 @@ TEST(PathLanes, SkyPointLightAndThroughputRouletteAsRadiance) {
   EXPECT_NEAR(double(lanes.rays), double(scalar.rays), 1e-4 * double(scalar.rays));
 }
 
+// The VPL weight window: roulette by the VPLs' estimate, and splits whose branches a lane traces after
+// its sample's first path, with radiance()'s numbers and branch budget. (Rounding that sends one of
+// the rare paths through the door's slit another way shows more here than in the Cornell box.)
+TEST(PathLanes, WeightWindowSplitsAsRadiance) {
+  if (!cpuHasLanes()) GTEST_SKIP() << "this CPU has no AVX2 and FMA: the lanes never run";
+  RenderJobSettings s = brdf(64, 48, 4);
+  s.scenePath = test::sourceDir() + "/scenes/door_ajar.gltf";
+  s.tracer.roulette = RouletteRule::Vpl;
+  const auto [lanes, scalar] = withAndWithout(s);
+  EXPECT_GT(scalar.branches, scalar.samples / 4);
+  EXPECT_NEAR(double(lanes.branches), double(scalar.branches), 1e-3 * double(scalar.branches));
+  EXPECT_NEAR(double(lanes.rays), double(scalar.rays), 1e-3 * double(scalar.rays));
+  EXPECT_LT(relMse(lanes.image, scalar.image), 1e-4);
+}
+
 // Against an answer of its own: inside a closed box of albedo rho whose walls all emit le, radiance is
 // le / (1 - rho) everywhere (to 32 segments, within rho^32).
 TEST(PathLanes, WhiteFurnaceConverges) {
