@@ -109,7 +109,7 @@ void RenderOptions::addCommonTo(CLI::App& command) {
   command.add_option_function<std::string>(
             "--lanes", [this](const std::string& v) { tracer.lanes = v == "auto"; },
             "brdf: auto (the default; eight paths at a time in AVX2 lanes, the same samples, where every material is "
-            "Lambertian, untextured, opaque and flat-shaded) | off (one path at a time everywhere: the ablation)")
+            "Lambertian, untextured and opaque) | off (one path at a time everywhere: the ablation)")
       ->check(CLI::IsMember({"auto", "off"}));
   command.add_option("--sky", sky, "uniform sky radiance R,G,B; 0 turns it off (default: on only without lights)");
   command.add_option("--sampler", sampler,

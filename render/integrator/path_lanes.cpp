@@ -30,14 +30,6 @@ std::string PathLanes::unsupported(const PathTracer& tracer) {
     SurfaceHit probe;
     probe.material = m.material;
     if (!scene.bsdf(probe).lambertian()) return "a material with a specular lobe";
-    if (m.normals.empty()) continue;
-    for (size_t i = 0; i < m.indices.size(); ++i) {
-      const glm::vec3 ng = scene.triangleFacts(mesh, uint32_t(i / 3)).normal, n = m.normals[m.indices[i]];
-      const float length = glm::length(n);
-      // Normals along the face's, either way: surface() turns them to the face's side.
-      if (length > 1e-8f && std::isfinite(length) && std::abs(glm::dot(n / length, ng)) < 1.0f - 1e-6f)
-        return "smooth shading normals";
-    }
   }
   return "";
 }
@@ -57,6 +49,9 @@ PathLanes::PathLanes(const PathTracer& tracer) : tracer_(tracer), scene_(tracer.
       triangles_.push_back({m.positions[idx[0]], m.positions[idx[1]], m.positions[idx[2]], facts.normal, albedo,
                             facts.coordinateScale});
       emits_.push_back(!isBlack(le));
+      smooth_.push_back(m.normals.empty() ? UINT32_MAX : uint32_t(normals_.size()));
+      if (!m.normals.empty())
+        for (int i = 0; i < 3; ++i) normals_.push_back(m.normals[idx[i]]);
     }
   }
 }
@@ -204,7 +199,7 @@ class PathLanes::Batch {
     stats_.rays += uint64_t(count(alive_));
 
     // The hits, lane by lane: position, the normal facing the ray, the triangle's facts.
-    F8 px{}, py{}, pz{}, nx{}, ny{}, nz{}, ar{}, ag{}, ab{}, scale{};
+    F8 px{}, py{}, pz{}, nx{}, ny{}, nz{}, sx{}, sy{}, sz{}, ar{}, ag{}, ab{}, scale{};
     I8 hitEmitter{};
     for (int k = 0; k < kLanes; ++k) {
       if (!alive_[k]) continue;
@@ -222,14 +217,24 @@ class PathLanes::Batch {
       if (n == glm::vec3(0.0f)) n = -d;  // degenerate, as surface() does
       const bool front = glm::dot(n, d) < 0.0f;
       if (!front) n = -n;
-      px[k] = p.x, py[k] = p.y, pz[k] = p.z, nx[k] = n.x, ny[k] = n.y, nz[k] = n.z;
+      glm::vec3 ns = n;  // the shading normal, interpolated as surface() does, on n's side
+      if (const uint32_t first = lanes_.smooth_[g]; first != UINT32_MAX) {
+        const glm::vec3* vn = &lanes_.normals_[first];
+        const glm::vec3 interpolated = vn[0] * b0 + vn[1] * u + vn[2] * v;
+        const float length = glm::length(interpolated);
+        if (length > 1e-8f && std::isfinite(length)) {
+          ns = interpolated / length;
+          if (glm::dot(ns, n) < 0.0f) ns = -ns;
+        }
+      }
+      px[k] = p.x, py[k] = p.y, pz[k] = p.z, nx[k] = n.x, ny[k] = n.y, nz[k] = n.z, sx[k] = ns.x, sy[k] = ns.y, sz[k] = ns.z;
       ar[k] = t.albedo.x, ag[k] = t.albedo.y, ab[k] = t.albedo.z, scale[k] = t.coordinateScale;
       frontFace_[k] = front;
       if (lanes_.emits_[g]) hitEmitter[k] = -1;
     }
     float emitted[kLanes] = {};
     for (int k = 0; k < kLanes; ++k)
-      if (hitEmitter[k]) emitted[k] = emitterHit(k, hitSurface(k, px, py, pz, nx, ny, nz, scale, rh.hit.geomID[k], rh.hit.primID[k]));
+      if (hitEmitter[k]) emitted[k] = emitterHit(k, hitSurface(k, px, py, pz, nx, ny, nz, sx, sy, sz, scale, rh.hit.geomID[k], rh.hit.primID[k]));
     end(depth_ + 1 > settings_.maxDepth);
     if (!any(alive_)) return;
 
@@ -281,15 +286,18 @@ class PathLanes::Batch {
     for (int k = 0; k < kLanes; ++k) {
       tested[k] = 0;
       if (!alive_[k]) continue;
-      const glm::vec3 p(px[k], py[k], pz[k]), n(nx[k], ny[k], nz[k]);
+      const glm::vec3 p(px[k], py[k], pz[k]), n(nx[k], ny[k], nz[k]), ns(sx[k], sy[k], sz[k]);
       VertexSamples& u = *numbers[k];
       const auto lightChoice = [&] { return u.lightChoice(); };
       const auto ls = guide_ ? guide_->sample(p, u.lightPoint(), lightChoice) : emitters_.sampleStratified(p, u.lightPoint(), lightChoice);
       if (!ls) continue;
-      // The Lambertian lobe's eval and pdf (Bsdf::eval, Bsdf::pdf), its frame's normal n.
-      const float cosReceiver = glm::dot(ls->wi, n), cosOutgoing = -(dx_[k] * n.x + dy_[k] * n.y + dz_[k] * n.z);
-      if (!(cosReceiver > 0.0f) || cosOutgoing <= 0.0f) continue;
-      const glm::vec3 f = glm::vec3(ar[k], ag[k], ab[k]) * kInvPiF * cosReceiver;
+      // The light must be above the surface; the Lambertian lobe's eval and pdf (Bsdf::eval, Bsdf::pdf)
+      // take the cosines with its frame's normal, the shading normal.
+      const float cosReceiver = glm::dot(ls->wi, n);
+      if (!(cosReceiver > 0.0f)) continue;
+      const float cosIn = glm::dot(ls->wi, ns), cosOutgoing = -(dx_[k] * ns.x + dy_[k] * ns.y + dz_[k] * ns.z);
+      if (cosOutgoing <= 0.0f || cosIn <= 0.0f) continue;
+      const glm::vec3 f = glm::vec3(ar[k], ag[k], ab[k]) * kInvPiF * cosIn;
       if (isBlack(f)) continue;
       ++stats_.rays;
       if (guide_) guide_->attempted(ls->guideSlot);
@@ -300,7 +308,7 @@ class PathLanes::Batch {
       shadow.dir_x[k] = r.direction.x, shadow.dir_y[k] = r.direction.y, shadow.dir_z[k] = r.direction.z;
       shadow.tnear[k] = 0.0f, shadow.tfar[k] = r.tMax, shadow.time[k] = 0.0f;
       shadow.mask[k] = ~0u, shadow.id[k] = 0, shadow.flags[k] = 0;
-      const float w = ls->delta ? 1.0f : powerHeuristic(ls->pdf, cosineHemispherePdf(cosReceiver));
+      const float w = ls->delta ? 1.0f : powerHeuristic(ls->pdf, cosineHemispherePdf(cosIn));
       contribution[k] = f * ls->radiance * (w / ls->pdf);
       arrival[k] = luminance(ls->radiance) * cosReceiver / ls->pdf;
       slot[k] = ls->guideSlot;
@@ -318,7 +326,7 @@ class PathLanes::Batch {
 
     // A split's other branches, each with its own numbers, traced after this path in radiance()'s order.
     for (int k = 0; k < kLanes; ++k)
-      if (alive_[k] && split[k] > 1) branch(k, split[k], hitSurface(k, px, py, pz, nx, ny, nz, scale, rh.hit.geomID[k], rh.hit.primID[k]));
+      if (alive_[k] && split[k] > 1) branch(k, split[k], hitSurface(k, px, py, pz, nx, ny, nz, sx, sy, sz, scale, rh.hit.geomID[k], rh.hit.primID[k]));
 
     // The continuation: Bsdf::sampleLambertian (sampleCosineHemisphere in the frame of n) in lanes.
     const F8 u0 = min8(uDir0, splat(0x1.fffffep-1f));
@@ -331,14 +339,14 @@ class PathLanes::Batch {
     sinCosOctant(0.25f * std::numbers::pi_v<float> * ((aboutX ? oy : ox) / safeRadius), s, c);
     const F8 lx = centre ? F8{} : radius * (aboutX ? c : s), ly = centre ? F8{} : radius * (aboutX ? s : c);
     const F8 z = sqrt8(max8(F8{}, 1.0f - lx * lx - ly * ly));
-    const I8 sampled = alive_ & (z > 0.0f) & (dx_ * nx + dy_ * ny + dz_ * nz < 0.0f);  // and wo above the lobe
+    const I8 sampled = alive_ & (z > 0.0f) & (dx_ * sx + dy_ * sy + dz_ * sz < 0.0f);  // and wo above the lobe
     stats_.bsdfSamples += uint64_t(count(sampled));
-    // Frame::fromNormal (Duff et al.): the sign is copysign(1, n.z).
-    const F8 sign = F8((I8(nz) & int32_t(0x80000000)) | I8(splat(1.0f)));
-    const F8 a = -1.0f / (sign + nz), b = nx * ny * a;
-    const F8 sx = 1.0f + sign * nx * nx * a, sy = sign * b, sz = -sign * nx;
-    const F8 tx = b, ty = sign + ny * ny * a, tz = -ny;
-    F8 wx = sx * lx + tx * ly + nx * z, wy = sy * lx + ty * ly + ny * z, wz = sz * lx + tz * ly + nz * z;
+    // Frame::fromNormal of the shading normal (Duff et al.): the sign is copysign(1, n.z).
+    const F8 sign = F8((I8(sz) & int32_t(0x80000000)) | I8(splat(1.0f)));
+    const F8 a = -1.0f / (sign + sz), b = sx * sy * a;
+    const F8 ux = 1.0f + sign * sx * sx * a, uy = sign * b, uz = -sign * sx;
+    const F8 vx = b, vy = sign + sy * sy * a, vz = -sy;
+    F8 wx = ux * lx + vx * ly + sx * z, wy = uy * lx + vy * ly + sy * z, wz = uz * lx + vz * ly + sz * z;
     const F8 inverseLength = 1.0f / sqrt8(wx * wx + wy * wy + wz * wz);
     wx *= inverseLength, wy *= inverseLength, wz *= inverseLength;
     const I8 reflects = (max8(ar, max8(ag, ab)) > 0.0f) & (wx * nx + wy * ny + wz * nz > 0.0f);
@@ -370,10 +378,12 @@ class PathLanes::Batch {
   }
 
   // The SurfaceHit of lane k's hit, for the scalar calls that take one.
-  SurfaceHit hitSurface(int k, F8 px, F8 py, F8 pz, F8 nx, F8 ny, F8 nz, F8 scale, uint32_t mesh, uint32_t triangle) const {
+  SurfaceHit hitSurface(int k, F8 px, F8 py, F8 pz, F8 nx, F8 ny, F8 nz, F8 sx, F8 sy, F8 sz, F8 scale, uint32_t mesh,
+                        uint32_t triangle) const {
     SurfaceHit s;
     s.position = glm::vec3(px[k], py[k], pz[k]);
-    s.geometricNormal = s.shadingNormal = glm::vec3(nx[k], ny[k], nz[k]);
+    s.geometricNormal = glm::vec3(nx[k], ny[k], nz[k]);
+    s.shadingNormal = glm::vec3(sx[k], sy[k], sz[k]);
     s.mesh = mesh, s.triangle = triangle, s.material = scene_.data().meshes[mesh].material;
     s.frontFace = frontFace_[k];
     s.coordinateScale = scale[k];

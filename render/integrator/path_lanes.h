@@ -12,9 +12,9 @@
 // numbers and the same share of the sample's branch budget.
 //
 // Only where the vector form is the whole model (unsupported() says why not, and the caller keeps
-// radiance()): BSDF sampling, no VPL connections, every material Lambertian,
-// untextured and opaque, every triangle flat-shaded (vertex normals, if any, along its own), and a
-// CPU with AVX2 and FMA (this file's vector code is compiled for them alone, and chosen at run time).
+// radiance()): BSDF sampling, no VPL connections, every material Lambertian, untextured and opaque
+// (shading normals interpolated as RenderScene::surface does), and a CPU with AVX2 and FMA (this
+// file's vector code is compiled for them alone, and chosen at run time).
 // `--lanes off` keeps radiance() everywhere: the ablation, and what the tests compare against.
 #pragma once
 #include <cstdint>
@@ -56,6 +56,8 @@ class PathLanes {
   std::vector<uint32_t> meshBase_;
   std::vector<Triangle> triangles_;
   std::vector<uint8_t> emits_;  // the triangle is one of EmitterSet's lights
+  std::vector<uint32_t> smooth_;  // where the triangle's three vertex normals start in normals_; UINT32_MAX: none
+  std::vector<glm::vec3> normals_;
 };
 
 }  // namespace vpl
