@@ -210,7 +210,7 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
     if (autoRoulette && !window.on() && WindowSwitch::updateDue(uint64_t(result.spp))) {
       if (window.update(film)) {
         result.windowFromPass = result.spp;
-        renderer.reset();
+        renderer.reset();  // both hold the tracer being replaced
         lanes.reset();
         tracer = windowTracer();
         makeRenderer();
