@@ -57,8 +57,12 @@ PathLanes::PathLanes(const PathTracer& tracer) : tracer_(tracer), scene_(tracer.
 }
 
 // The vector code below is compiled for AVX2 and FMA alone; unsupported() keeps other CPUs out.
+#if defined(__clang__)
+#pragma clang attribute push(__attribute__((target("avx2,fma"))), apply_to = function)
+#else
 #pragma GCC push_options
 #pragma GCC target("avx2,fma")
+#endif
 
 namespace {
 
@@ -83,7 +87,7 @@ void sinCosOctant(F8 x, F8& s, F8& c) {
 
 // offsetRayOrigin (accel.cpp), eight points at once; n is the side to leave by.
 void offsetRayOrigins(F8& px, F8& py, F8& pz, F8 nx, F8 ny, F8 nz, F8 coordinateScale) {
-  const F8 scale = (coordinateScale > 0.0f) & (coordinateScale < INFINITY) ? coordinateScale : splat(1.0f);
+  const F8 scale = ((coordinateScale > 0.0f) & (coordinateScale < INFINITY)) ? coordinateScale : splat(1.0f);
   const F8 kOrigin = scale / 32.0f, kFloatScale = scale / 65536.0f;
   const auto offset = [&](F8 p, F8 n) {
     const I8 step = __builtin_convertvector(256.0f * n, I8);
@@ -180,7 +184,7 @@ class PathLanes::Batch {
   void end(I8 lanes) { alive_ &= ~lanes; }
   glm::vec3 beta(int k) const { return {br_[k], bg_[k], bb_[k]}; }
 
-  // One vertex of every live lane: radiance()'s loop body for BSDF sampling without window or joins.
+  // One vertex of every live lane: radiance()'s loop body for BSDF sampling without joins.
   void bounce() {
     const RTCScene handle = scene_.accel().handle();
     RTCIntersectContext context;
@@ -241,7 +245,7 @@ class PathLanes::Batch {
     // The vertex's numbers, from each lane's sampler (the same slots as radiance()).
     std::optional<VertexSamples>* numbers = numbers_;
     for (int k = 0; k < kLanes; ++k)
-      if (alive_[k]) numbers[k].emplace(*samplers_[k], depth_[k]);
+      if (alive_[k]) numbers[k].emplace(*samplers_[k], int(depth_[k]));
 
     // The VPL weight window: roulette for paths worth little against the pixel, splitting for those
     // worth much; the camera ray's hit sets the pixel's estimate.
@@ -472,6 +476,10 @@ void PathLanes::renderTile(const Camera& camera, uint64_t seed, uint64_t pass, i
   Batch(*this, camera, seed, pass, x0, y0, x1, y1, film, stats, discarded).run();
 }
 
+#if defined(__clang__)
+#pragma clang attribute pop
+#else
 #pragma GCC pop_options
+#endif
 
 }  // namespace vpl
