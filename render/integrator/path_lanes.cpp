@@ -8,6 +8,7 @@
 #include <embree3/rtcore.h>
 #include "render/core/color.h"
 #include "render/guide/emitter_guide.h"
+#include "render/sampling/fast_trig.h"
 #include "render/sampling/pixel_sampler.h"
 #include "render/integrator/weight_window.h"
 #include "render/sampling/warps.h"
@@ -78,25 +79,13 @@ F8 abs8(F8 a) { return F8(I8(a) & 0x7fffffff); }
 bool any(I8 m) { return _mm256_movemask_ps(__m256(m)) != 0; }
 int count(I8 m) { return __builtin_popcount(unsigned(_mm256_movemask_ps(__m256(m)))); }
 
-// fast::sinCosOctant, lane by lane (|x| <= pi / 4).
-void sinCosOctant(F8 x, F8& s, F8& c) {
-  const F8 z = x * x;
-  s = x + x * z * (-0.16666659411f + z * (0.0083324080842f + z * -0.00019543791327f));
-  c = 1.0f - 0.5f * z + z * z * (0.041666646866f + z * (-0.0013887367487f + z * 2.4438448729e-05f));
-}
-
 // offsetRayOrigin (accel.cpp), eight points at once; n is the side to leave by.
 void offsetRayOrigins(F8& px, F8& py, F8& pz, F8 nx, F8 ny, F8 nz, F8 coordinateScale) {
   const F8 scale = ((coordinateScale > 0.0f) & (coordinateScale < INFINITY)) ? coordinateScale : splat(1.0f);
-  const F8 kOrigin = scale / 32.0f, kFloatScale = scale / 65536.0f;
-  const auto offset = [&](F8 p, F8 n) {
-    const I8 step = __builtin_convertvector(256.0f * n, I8);
-    const I8 negative = p < 0.0f;
-    const I8 bits = I8(p) + ((step ^ negative) - negative);
-    const I8 nearZero = F8(I8(p) & 0x7fffffff) < kOrigin;
-    return nearZero ? p + kFloatScale * n : F8(bits);
-  };
-  px = offset(px, nx), py = offset(py, ny), pz = offset(pz, nz);
+  const F8 origin = scale / 32.0f, floatScale = scale / 65536.0f;
+  offsetCoordinates<F8, I8>(px, nx, origin, floatScale);
+  offsetCoordinates<F8, I8>(py, ny, origin, floatScale);
+  offsetCoordinates<F8, I8>(pz, nz, origin, floatScale);
 }
 
 }  // namespace
@@ -340,7 +329,7 @@ class PathLanes::Batch {
     const F8 radius = aboutX ? ox : oy;
     const F8 safeRadius = centre ? splat(1.0f) : radius;
     F8 s, c;
-    sinCosOctant(0.25f * std::numbers::pi_v<float> * ((aboutX ? oy : ox) / safeRadius), s, c);
+    fast::sinCosOctant(0.25f * std::numbers::pi_v<float> * ((aboutX ? oy : ox) / safeRadius), s, c);
     const F8 lx = centre ? F8{} : radius * (aboutX ? c : s), ly = centre ? F8{} : radius * (aboutX ? s : c);
     const F8 z = sqrt8(max8(F8{}, 1.0f - lx * lx - ly * ly));
     const I8 sampled = alive_ & (z > 0.0f) & (dx_ * sx + dy_ * sy + dz_ * sz < 0.0f);  // and wo above the lobe

@@ -11,12 +11,17 @@ struct SinCos {
   float sin, cos;
 };
 
-// For |x| <= pi / 4.
+// For |x| <= pi / 4; T is float or a vector of floats (render/integrator/path_lanes: eight at once).
+template <class T>
+inline void sinCosOctant(const T& x, T& s, T& c) {  // by reference: see offsetCoordinates (accel.h)
+  const T z = x * x;
+  s = x + x * z * (-0.16666659411f + z * (0.0083324080842f + z * -0.00019543791327f));
+  c = 1.0f - 0.5f * z + z * z * (0.041666646866f + z * (-0.0013887367487f + z * 2.4438448729e-05f));
+}
 inline SinCos sinCosOctant(float x) {
-  const float z = x * x;
-  const float s = x + x * z * (-0.16666659411f + z * (0.0083324080842f + z * -0.00019543791327f));
-  const float c = 1.0f - 0.5f * z + z * z * (0.041666646866f + z * (-0.0013887367487f + z * 2.4438448729e-05f));
-  return {s, c};
+  SinCos r;
+  sinCosOctant(x, r.sin, r.cos);
+  return r;
 }
 
 // sin and cos of (pi / 4) t for t in [0, 2]: the upper half folds onto the lower by cos(pi/2 - x) = sin x.

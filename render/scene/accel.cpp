@@ -69,14 +69,8 @@ glm::vec3 offsetRayOrigin(const glm::vec3& p, const glm::vec3& n, float coordina
   typedef float Float4 __attribute__((vector_size(16)));
   typedef int32_t Int4 __attribute__((vector_size(16)));
   const float scale = coordinateScale > 0.0f && std::isfinite(coordinateScale) ? coordinateScale : 1.0f;
-  const float kOrigin = scale / 32.0f, kFloatScale = scale / 65536.0f;
-  constexpr float kIntScale = 256.0f;
-  const Float4 p4 = {p.x, p.y, p.z, 0.0f}, n4 = {n.x, n.y, n.z, 0.0f};
-  const Int4 offset = __builtin_convertvector(kIntScale * n4, Int4);
-  const Int4 negative = p4 < 0.0f;                       // -1 where p < 0: the offset's sign flips
-  const Int4 bits = (Int4)p4 + ((offset ^ negative) - negative);
-  const Int4 nearZero = (Float4)((Int4)p4 & 0x7fffffff) < kOrigin;  // |p| < kOrigin
-  const Float4 out = nearZero ? p4 + kFloatScale * n4 : (Float4)bits;
+  Float4 out = {p.x, p.y, p.z, 0.0f};
+  offsetCoordinates<Float4, Int4>(out, Float4{n.x, n.y, n.z, 0.0f}, Float4{} + scale / 32.0f, Float4{} + scale / 65536.0f);
   return {out[0], out[1], out[2]};
 }
 
