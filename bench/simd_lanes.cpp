@@ -24,6 +24,7 @@
 #include <embree3/rtcore.h>
 #include "render/core/color.h"
 #include "render/integrator/path_tracer.h"
+#include "render/sampling/lane_sobol.h"
 #include "render/sampling/pixel_sampler.h"
 #include "render/scene/camera.h"
 #include "render/scene/gltf_loader.h"
@@ -178,40 +179,15 @@ struct Lanes {
   }
 };
 
-// PixelSampler's stratified numbers (render/sampling/pixel_sampler.h, sobol.h) for N lanes at once:
-// the same hashes, scrambles and bit reversals in vector arithmetic (main() checks them against
-// PixelSampler, number for number). Only the second Sobol' dimension's table is read lane by lane.
+// PixelSampler's stratified numbers for N lanes at once (render/sampling/lane_sobol.h; main() checks
+// them against PixelSampler, number for number).
 template <int N>
 struct LaneSobol {
   using F = typename VectorTypes<N>::F;
   using U = typename VectorTypes<N>::U;
   using U64 = typename VectorTypes<N>::U64;
-
-  static U reverseBits(U x) {
-    x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
-    x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
-    x = ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
-    x = ((x >> 8) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8);
-    return (x >> 16) | (x << 16);
-  }
-  static U scramble(U x, U seed) { return sobol::nestedScrambleReversed(x, seed); }
-  static U64 mix64(U64 x) {
-    x += 0x9e3779b97f4a7c15ull;
-    x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
-    x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
-    return x ^ (x >> 31);
-  }
-  static U low(U64 x) { return __builtin_convertvector(x, U); }
-  static F unit(U v) { return __builtin_convertvector(v >> 8, F) * 0x1p-24f; }
-
-  // Both coordinates of each lane's slot (a slot per lane: lanes are at different depths).
-  static void point(U64 pixelKey, U reversedIndex, U slot, F& x, F& y) {
-    const U64 slotHash = mix64(pixelKey + __builtin_convertvector(slot, U64));
-    const U index = reverseBits(scramble(reversedIndex, low(slotHash)));
-    x = unit(reverseBits(scramble(index, low(slotHash >> 32))));
-    U second;
-    for (int k = 0; k < N; ++k) second[k] = sobol::reversedSobolSecond(index[k]);
-    y = unit(reverseBits(scramble(second, low(mix64(slotHash)))));
+  static void point(const U64& pixelKey, const U& reversedIndex, const U& slot, F& x, F& y) {
+    lane_sobol::point(pixelKey, reversedIndex, slot, x, y);
   }
 };
 

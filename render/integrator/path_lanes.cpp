@@ -9,6 +9,7 @@
 #include "render/core/color.h"
 #include "render/guide/emitter_guide.h"
 #include "render/sampling/fast_trig.h"
+#include "render/sampling/lane_sobol.h"
 #include "render/sampling/pixel_sampler.h"
 #include "render/integrator/weight_window.h"
 #include "render/sampling/warps.h"
@@ -69,6 +70,8 @@ namespace {
 
 typedef float F8 __attribute__((vector_size(32)));
 typedef int32_t I8 __attribute__((vector_size(32)));
+typedef uint32_t U8 __attribute__((vector_size(32)));
+typedef uint64_t U64x8 __attribute__((vector_size(64)));
 constexpr float kInvPiF = std::numbers::inv_pi_v<float>;
 
 F8 splat(float x) { return F8{} + x; }
@@ -171,6 +174,28 @@ class PathLanes::Batch {
   }
 
   void end(I8 lanes) { alive_ &= ~lanes; }
+
+  // The two numbers every vertex reads (VertexSamples::drawAhead), for the lanes whose vertex draws
+  // from the stratified slots, at once; the others (a split's branches, deep vertices) draw their own.
+  void drawAhead(std::optional<VertexSamples>* numbers) {
+    U64x8 keys{};
+    U8 reversed{}, lightSlot{}, bsdfSlot{};
+    I8 stratified{};
+    for (int k = 0; k < kLanes; ++k) {
+      if (!alive_[k] || !samplers_[k]->stratifiedAt(depth_[k])) continue;
+      stratified[k] = -1;
+      keys[k] = samplers_[k]->pixelKey();
+      reversed[k] = samplers_[k]->reversedIndex();
+      lightSlot[k] = PixelSampler::slotOf(depth_[k], VertexDimension::LightPoint);
+      bsdfSlot[k] = PixelSampler::slotOf(depth_[k], VertexDimension::BsdfDirection);
+    }
+    if (!any(stratified)) return;
+    F8 lightX, lightY, bsdfX, bsdfY;
+    lane_sobol::point(keys, reversed, lightSlot, lightX, lightY);
+    lane_sobol::point(keys, reversed, bsdfSlot, bsdfX, bsdfY);
+    for (int k = 0; k < kLanes; ++k)
+      if (stratified[k]) numbers[k]->drawnAhead({lightX[k], lightY[k]}, {bsdfX[k], bsdfY[k]});
+  }
   glm::vec3 beta(int k) const { return {br_[k], bg_[k], bb_[k]}; }
 
   // One vertex of every live lane: radiance()'s loop body for BSDF sampling without joins.
@@ -235,6 +260,7 @@ class PathLanes::Batch {
     std::optional<VertexSamples>* numbers = numbers_;
     for (int k = 0; k < kLanes; ++k)
       if (alive_[k]) numbers[k].emplace(*samplers_[k], int(depth_[k]));
+    drawAhead(numbers);
 
     // The VPL weight window: roulette for paths worth little against the pixel, splitting for those
     // worth much; the camera ray's hit sets the pixel's estimate.

@@ -95,6 +95,14 @@ class PixelSampler {
     b.sampleKey_ = mix64(sampleKey_ ^ (0x6272616e63680000ull + id));
     return b;
   }
+  // For numbers drawn for many lanes at once (lane_sobol.h): whether `vertex` draws from the
+  // stratified slots, and the keys they hash.
+  bool stratifiedAt(int vertex) const { return stratified(vertex) && !independent_; }
+  uint64_t pixelKey() const { return pixelKey_; }
+  uint32_t reversedIndex() const { return reversedIndex_; }
+  static uint32_t slotOf(int vertex, VertexDimension d) {
+    return kFirstVertexSlot + uint32_t(vertex) * uint32_t(VertexDimension::Count) + uint32_t(d);
+  }
   // A stream of its own for a vertex's consumer of an unbounded count of numbers.
   Rng random(int vertex) {
     if (independent_) return Rng::hashed(independent_->next() | uint64_t(independent_->next()) << 32);
@@ -105,9 +113,6 @@ class PixelSampler {
   static constexpr uint32_t kCameraSlot = 0, kPreviewClusterSlot = 1, kFirstVertexSlot = 2;
   // A vertex whose numbers come from the stratified slots, not the hashed fallback.
   bool stratified(int vertex) const { return vertex < kTabulatedVertices && !branch_ && !hashedOnly_; }
-  static uint32_t slotOf(int vertex, VertexDimension d) {
-    return kFirstVertexSlot + uint32_t(vertex) * uint32_t(VertexDimension::Count) + uint32_t(d);
-  }
 
   // One hash of (pixel, slot) gives the slot's shuffle and its scrambles (the second coordinate's
   // through Pair::y(), when asked).
@@ -169,6 +174,11 @@ class VertexSamples {
   void drawAhead() {
     lightPoint();
     bsdfDirection();
+  }
+  // The same two numbers, drawn elsewhere from this vertex's slots (lane_sobol.h).
+  void drawnAhead(glm::vec2 lightPoint, glm::vec2 bsdfDirection) {
+    lightPoint_ = lightPoint;
+    bsdfDirection_ = bsdfDirection;
   }
   // The vertex's own random stream (Metropolis chains), made on first use.
   Rng& random() {

@@ -9,11 +9,18 @@
 namespace vpl {
 
 // SplitMix64 finaliser: a good 64-bit mix for deriving stream seeds.
-inline uint64_t mix64(uint64_t x) {
+// In place, T a uint64_t or a vector of them (render/sampling/lane_sobol.h hashes eight lanes' keys at
+// once; by reference, so that no vector crosses a call between code built for different CPUs).
+template <class T>
+inline void mix64InPlace(T& x) {
   x += 0x9e3779b97f4a7c15ull;
   x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
   x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
-  return x ^ (x >> 31);
+  x ^= x >> 31;
+}
+inline uint64_t mix64(uint64_t x) {
+  mix64InPlace(x);
+  return x;
 }
 
 class Rng {

@@ -71,15 +71,18 @@ inline uint32_t sobolSecond(uint32_t index) { return reverseBits(reversedSobolSe
 // fraction as a random function of the digits before it. With the bits reversed, "before" means
 // "below", and x + c, x * odd and x ^ (x * even) each change a bit only as a function of the bits
 // below it: their composition is such a scramble. It keeps every net a net and makes each point
-// uniformly distributed, so estimates stay unbiased. This is the scramble on reversed bits; T is
-// uint32_t, or a vector of them (bench/simd_lanes draws eight lanes' numbers at once).
+// uniformly distributed, so estimates stay unbiased. This is the scramble on reversed bits, in place; T
+// is uint32_t, or a vector of them (lane_sobol.h draws eight lanes' numbers at once).
 template <class T>
-inline T nestedScrambleReversed(T x, T seed) {
+inline void nestedScrambleReversedInPlace(T& x, const T& seed) {
   x ^= x * 0x3d20adeau;
   x += seed;
   x *= (seed >> 16) | 1u;
   x ^= x * 0x05526c56u;
   x ^= x * 0x53a22864u;
+}
+inline uint32_t nestedScrambleReversed(uint32_t x, uint32_t seed) {
+  nestedScrambleReversedInPlace(x, seed);
   return x;
 }
 inline uint32_t owenScramble(uint32_t v, uint32_t seed) { return reverseBits(nestedScrambleReversed(reverseBits(v), seed)); }

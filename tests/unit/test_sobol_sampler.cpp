@@ -13,6 +13,7 @@
 #include "render/core/frame.h"
 #include "render/film/film.h"
 #include "render/material/bsdf.h"
+#include "render/sampling/lane_sobol.h"
 #include "render/sampling/pixel_sampler.h"
 #include "render/sampling/rng.h"
 #include "render/sampling/sobol.h"
@@ -484,6 +485,43 @@ TEST(PixelSampler, DrawnAheadAndLazyNumbersAreGet2DsNumbers) {
       }
     }
   }
+}
+
+// Eight lanes' numbers at once (lane_sobol.h, the path lanes' draw): each lane's point is its own
+// sampler's get2D, bit for bit, whatever its pixel, sample index (past 2^32 too), vertex and slot; and
+// only the vertices that draw from the stratified slots say so.
+TEST(PixelSampler, LanesDrawEachSamplersOwnNumbers) {
+  typedef float F __attribute__((vector_size(32)));
+  typedef uint32_t U __attribute__((vector_size(32)));
+  typedef uint64_t U64 __attribute__((vector_size(64)));
+  for (const uint64_t index : {0ull, 1ull, 7ull, 1000ull, 0x100000003ull}) {
+    for (int vertex = 0; vertex < PixelSampler::kTabulatedVertices; ++vertex) {
+      U64 keys;
+      U reversed, slot;
+      std::vector<PixelSampler> samplers;
+      for (int k = 0; k < 8; ++k) {
+        const VertexDimension d = VertexDimension(uint32_t(k) % uint32_t(VertexDimension::Count));
+        samplers.emplace_back(5 + uint64_t(k % 2), uint64_t(k) * 7919u + index, index + uint64_t(k / 4));
+        ASSERT_TRUE(samplers.back().stratifiedAt(vertex));
+        keys[k] = samplers.back().pixelKey();
+        reversed[k] = samplers.back().reversedIndex();
+        slot[k] = PixelSampler::slotOf(vertex, d);
+      }
+      F x, y;
+      lane_sobol::point(keys, reversed, slot, x, y);
+      for (int k = 0; k < 8; ++k) {
+        const glm::vec2 expected = samplers[size_t(k)].get2D(vertex, VertexDimension(uint32_t(k) % uint32_t(VertexDimension::Count)));
+        ASSERT_EQ(x[k], expected.x) << "lane " << k << " vertex " << vertex << " index " << index;
+        ASSERT_EQ(y[k], expected.y) << "lane " << k << " vertex " << vertex << " index " << index;
+      }
+    }
+  }
+  PixelSampler sampler(5, 3, 4);
+  EXPECT_FALSE(sampler.stratifiedAt(PixelSampler::kTabulatedVertices));
+  EXPECT_FALSE(sampler.branch(1).stratifiedAt(0));
+  EXPECT_FALSE(PixelSampler(5, 3, 4, false).stratifiedAt(0));
+  Rng rng(1);
+  EXPECT_FALSE(PixelSampler(rng).stratifiedAt(0));
 }
 
 // Past the tabulated vertices, and in the per-vertex streams, numbers are hashed random: uniform,
