@@ -45,7 +45,8 @@ inline void point(const U64& pixelKey, const U& reversedIndex, const U& slot, F&
   for (int k = 0; k < int(sizeof(U) / sizeof(uint32_t)); ++k) second[k] = sobol::reversedSobolSecond(index[k]);
   U64 secondHash = slotHash;
   mix64InPlace(secondHash);
-  sobol::nestedScrambleReversedInPlace(second, U(__builtin_convertvector(secondHash, U)));
+  const U secondKey = __builtin_convertvector(secondHash, U);
+  sobol::nestedScrambleReversedInPlace(second, secondKey);
   reverseBits(second);
   toUnitFloat(second, y);
 }
