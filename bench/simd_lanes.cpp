@@ -179,18 +179,6 @@ struct Lanes {
   }
 };
 
-// PixelSampler's stratified numbers for N lanes at once (render/sampling/lane_sobol.h; main() checks
-// them against PixelSampler, number for number).
-template <int N>
-struct LaneSobol {
-  using F = typename VectorTypes<N>::F;
-  using U = typename VectorTypes<N>::U;
-  using U64 = typename VectorTypes<N>::U64;
-  static void point(const U64& pixelKey, const U& reversedIndex, const U& slot, F& x, F& y) {
-    lane_sobol::point(pixelKey, reversedIndex, slot, x, y);
-  }
-};
-
 // The lanes' paths and their traversal, N at a time.
 template <int N>
 class Wavefront {
@@ -207,7 +195,7 @@ class Wavefront {
   // flat arrays, 2 its Bsdf object instead of an inline Lambertian lobe, 3 the renderer's ray offsets
   // (spawnRay, spawnShadowRay) instead of a fixed one. At 3 the estimator is radiance()'s.
   // `laneSobol` (with `sobol`): the stratified numbers of the first PixelSampler::kTabulatedVertices
-  // vertices drawn for all lanes at once (LaneSobol), not lane by lane.
+  // vertices drawn for all lanes at once (render/sampling/lane_sobol.h), not lane by lane.
   Wavefront(const RenderScene& scene, const FlatScene& flat, const Camera& camera, bool sobol, bool solidAngle,
             int framework = 0, bool laneSobol = false)
       : scene_(scene.accel().handle()), renderScene_(scene), emitters_(scene.emitters()), flat_(flat), camera_(camera),
@@ -384,8 +372,8 @@ class Wavefront {
     const U firstSlot = 2u + U(depth_) * uint32_t(VertexDimension::Count);  // PixelSampler::slotOf
     F uLight0, uLight1, uDir0, uDir1;
     if (laneSobol_) {
-      LaneSobol<N>::point(pixelKey_, reversedIndex_, firstSlot + uint32_t(VertexDimension::LightPoint), uLight0, uLight1);
-      LaneSobol<N>::point(pixelKey_, reversedIndex_, firstSlot + uint32_t(VertexDimension::BsdfDirection), uDir0, uDir1);
+      lane_sobol::point(pixelKey_, reversedIndex_, firstSlot + uint32_t(VertexDimension::LightPoint), uLight0, uLight1);
+      lane_sobol::point(pixelKey_, reversedIndex_, firstSlot + uint32_t(VertexDimension::BsdfDirection), uDir0, uDir1);
       for (int k = 0; k < N; ++k)  // past the tabulated vertices: the sampler's hashed numbers
         if (alive_[k] && depth_[k] >= PixelSampler::kTabulatedVertices) {
           const glm::vec2 a = scalarNumbers(k).lightPoint(), b = scalarNumbers(k).bsdfDirection();
@@ -522,7 +510,7 @@ class Wavefront {
       F uRoulette = L::uniform(key, 4);
       if (laneSobol_) {
         F unused;
-        LaneSobol<N>::point(pixelKey_, reversedIndex_, firstSlot + uint32_t(VertexDimension::LightChoiceRoulette), unused, uRoulette);
+        lane_sobol::point(pixelKey_, reversedIndex_, firstSlot + uint32_t(VertexDimension::LightChoiceRoulette), unused, uRoulette);
       }
       if (sobol_)
         for (int k = 0; k < N; ++k)
@@ -578,7 +566,7 @@ double renderRadiance(const PathTracer& tracer, const Camera& camera, int passes
   return sum;
 }
 
-// LaneSobol against PixelSampler, number for number, over pixels, sample indices and vertices.
+// lane_sobol against PixelSampler, number for number, over pixels, sample indices and vertices.
 bool laneSobolAgrees() {
   using V = VectorTypes<8>;
   for (uint64_t pass : {0ull, 1ull, 5ull, 1000ull, 0x100000003ull})
@@ -593,7 +581,7 @@ bool laneSobolAgrees() {
           slot[k] = 2u + vertex * uint32_t(VertexDimension::Count) + uint32_t(d);
         }
         V::F x, y;
-        LaneSobol<8>::point(keys, reversed, slot, x, y);
+        lane_sobol::point(keys, reversed, slot, x, y);
         for (int k = 0; k < 8; ++k) {
           PixelSampler sampler(kSeed, uint64_t(k) * 7919u + pass, pass);
           const glm::vec2 expected = sampler.get2D(int(vertex), d);
@@ -621,7 +609,7 @@ int main(int argc, char** argv) {
       return 2;
     }
     if (!laneSobolAgrees()) {
-      std::fprintf(stderr, "simd_lanes: LaneSobol disagrees with PixelSampler\n");
+      std::fprintf(stderr, "simd_lanes: lane_sobol disagrees with PixelSampler\n");
       return 1;
     }
     const FlatScene flat(scene.data());
