@@ -228,10 +228,12 @@ class Wavefront {
     const uint32_t pixel = uint32_t(s % pixels), pass = uint32_t(s / pixels);
     key_[k] = hash32(pixel * 0x632be59bu ^ hash32(pass + 0x85ebca6bu));
     glm::vec2 jitter(L::unit(U{} + hash32(key_[k] ^ 0x1u))[0], L::unit(U{} + hash32(key_[k] ^ 0x2u))[0]);
-    if (sobol_) jitter = samplers_[k].emplace(kSeed, pixel, pass).cameraJitter();
-    // PixelSampler's keys, as its constructor makes them (main() checks that they agree).
-    pixelKey_[k] = mix64(mix64(kSeed ^ 0x736f626f6c000000ull) ^ pixel) ^ mix64(uint64_t(pass) >> 32);
-    reversedIndex_[k] = sobol::reverseBits(pass);
+    if (sobol_) {
+      PixelSampler& sampler = samplers_[k].emplace(kSeed, pixel, pass);
+      jitter = sampler.cameraJitter();
+      pixelKey_[k] = sampler.pixelKey();  // for lane_sobol
+      reversedIndex_[k] = sampler.reversedIndex();
+    }
     const Ray r = camera_.generateRay(glm::vec2(float(pixel % uint32_t(camera_.width())), float(pixel / uint32_t(camera_.width()))) + jitter);
     ox_[k] = r.origin.x, oy_[k] = r.origin.y, oz_[k] = r.origin.z;
     dx_[k] = r.direction.x, dy_[k] = r.direction.y, dz_[k] = r.direction.z;
@@ -575,10 +577,10 @@ bool laneSobolAgrees() {
         V::U64 keys;
         V::U reversed, slot;
         for (int k = 0; k < 8; ++k) {
-          const uint64_t pixel = uint64_t(k) * 7919u + pass;
-          keys[k] = mix64(mix64(kSeed ^ 0x736f626f6c000000ull) ^ pixel) ^ mix64(pass >> 32);
-          reversed[k] = sobol::reverseBits(uint32_t(pass));
-          slot[k] = 2u + vertex * uint32_t(VertexDimension::Count) + uint32_t(d);
+          const PixelSampler sampler(kSeed, uint64_t(k) * 7919u + pass, pass);
+          keys[k] = sampler.pixelKey();
+          reversed[k] = sampler.reversedIndex();
+          slot[k] = PixelSampler::slotOf(int(vertex), d);
         }
         V::F x, y;
         lane_sobol::point(keys, reversed, slot, x, y);

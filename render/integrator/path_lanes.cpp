@@ -85,10 +85,9 @@ int count(I8 m) { return __builtin_popcount(unsigned(_mm256_movemask_ps(__m256(m
 // offsetRayOrigin (accel.cpp), eight points at once; n is the side to leave by.
 void offsetRayOrigins(F8& px, F8& py, F8& pz, F8 nx, F8 ny, F8 nz, F8 coordinateScale) {
   const F8 scale = ((coordinateScale > 0.0f) & (coordinateScale < INFINITY)) ? coordinateScale : splat(1.0f);
-  const F8 origin = scale / 32.0f, floatScale = scale / 65536.0f;
-  offsetCoordinates<F8, I8>(px, nx, origin, floatScale);
-  offsetCoordinates<F8, I8>(py, ny, origin, floatScale);
-  offsetCoordinates<F8, I8>(pz, nz, origin, floatScale);
+  offsetCoordinates<F8, I8>(px, nx, scale);
+  offsetCoordinates<F8, I8>(py, ny, scale);
+  offsetCoordinates<F8, I8>(pz, nz, scale);
 }
 
 }  // namespace
@@ -177,7 +176,7 @@ class PathLanes::Batch {
 
   // The two numbers every vertex reads (VertexSamples::drawAhead), for the lanes whose vertex draws
   // from the stratified slots, at once; the others (a split's branches, deep vertices) draw their own.
-  void drawAhead(std::optional<VertexSamples>* numbers) {
+  void drawAhead() {
     U64x8 keys{};
     U8 reversed{}, lightSlot{}, bsdfSlot{};
     I8 stratified{};
@@ -194,7 +193,7 @@ class PathLanes::Batch {
     lane_sobol::point(keys, reversed, lightSlot, lightX, lightY);
     lane_sobol::point(keys, reversed, bsdfSlot, bsdfX, bsdfY);
     for (int k = 0; k < kLanes; ++k)
-      if (stratified[k]) numbers[k]->drawnAhead({lightX[k], lightY[k]}, {bsdfX[k], bsdfY[k]});
+      if (stratified[k]) numbers_[k]->drawnAhead({lightX[k], lightY[k]}, {bsdfX[k], bsdfY[k]});
   }
   glm::vec3 beta(int k) const { return {br_[k], bg_[k], bb_[k]}; }
 
@@ -257,10 +256,9 @@ class PathLanes::Batch {
     if (!any(alive_)) return;
 
     // The vertex's numbers, from each lane's sampler (the same slots as radiance()).
-    std::optional<VertexSamples>* numbers = numbers_;
     for (int k = 0; k < kLanes; ++k)
-      if (alive_[k]) numbers[k].emplace(*samplers_[k], int(depth_[k]));
-    drawAhead(numbers);
+      if (alive_[k]) numbers_[k].emplace(*samplers_[k], int(depth_[k]));
+    drawAhead();
 
     // The VPL weight window: roulette for paths worth little against the pixel, splitting for those
     // worth much; the camera ray's hit sets the pixel's estimate.
@@ -278,7 +276,7 @@ class PathLanes::Batch {
           windowed[k] = -1;
           const WindowDecision d = weightWindow(luminance(beta(k)) * predicted / pixelEstimate_[k], settings_.window);
           if (d.survival < 1.0f) {
-            if (numbers[k]->roulette() >= d.survival) {
+            if (numbers_[k]->roulette() >= d.survival) {
               alive_[k] = 0;
               continue;
             }
@@ -291,7 +289,7 @@ class PathLanes::Batch {
     F8 uDir0 = splat(0.5f), uDir1 = splat(0.5f);
     for (int k = 0; k < kLanes; ++k)
       if (alive_[k]) {
-        const glm::vec2 u = numbers[k]->bsdfDirection();
+        const glm::vec2 u = numbers_[k]->bsdfDirection();
         uDir0[k] = u.x, uDir1[k] = u.y;
       }
 
@@ -306,7 +304,7 @@ class PathLanes::Batch {
       tested[k] = 0;
       if (!alive_[k]) continue;
       const glm::vec3 p(px[k], py[k], pz[k]), n(nx[k], ny[k], nz[k]), ns(sx[k], sy[k], sz[k]);
-      VertexSamples& u = *numbers[k];
+      VertexSamples& u = *numbers_[k];
       const auto lightChoice = [&] { return u.lightChoice(); };
       const auto ls = guide_ ? guide_->sample(p, u.lightPoint(), lightChoice) : emitters_.sampleStratified(p, u.lightPoint(), lightChoice);
       if (!ls) continue;
@@ -380,7 +378,7 @@ class PathLanes::Batch {
       const F8 survive = min8(splat(1.0f), settings_.roulette == RouletteRule::Throughput ? largest : sqrt8(largest));
       I8 killed{};
       for (int k = 0; k < kLanes; ++k)
-        if (rolls[k] && numbers[k]->roulette() >= survive[k]) killed[k] = -1;
+        if (rolls[k] && numbers_[k]->roulette() >= survive[k]) killed[k] = -1;
       const F8 divisor = rolls ? survive : splat(1.0f);
       br_ /= divisor, bg_ /= divisor, bb_ /= divisor;
       end(killed);

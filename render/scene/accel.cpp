@@ -70,7 +70,7 @@ glm::vec3 offsetRayOrigin(const glm::vec3& p, const glm::vec3& n, float coordina
   typedef int32_t Int4 __attribute__((vector_size(16)));
   const float scale = coordinateScale > 0.0f && std::isfinite(coordinateScale) ? coordinateScale : 1.0f;
   Float4 out = {p.x, p.y, p.z, 0.0f};
-  offsetCoordinates<Float4, Int4>(out, Float4{n.x, n.y, n.z, 0.0f}, Float4{} + scale / 32.0f, Float4{} + scale / 65536.0f);
+  offsetCoordinates<Float4, Int4>(out, Float4{n.x, n.y, n.z, 0.0f}, Float4{} + scale);
   return {out[0], out[1], out[2]};
 }
 

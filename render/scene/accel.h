@@ -33,16 +33,17 @@ struct RayHit {
 // near zero a coordinate's rounding error follows that scale, not the coordinate itself.
 glm::vec3 offsetRayOrigin(const glm::vec3& p, const glm::vec3& geometricNormal, float coordinateScale);
 // Its step, element by element, for GCC vectors F of floats and I of int32 (offsetRayOrigin takes the
-// three coordinates at once, render/integrator/path_lanes one coordinate of eight points):
-// 256 ulps along n, and where |p| < origin (ulps vanish near zero) floatScale n. (By reference: a
-// 32-byte vector passed by value would change the ABI between code with and without AVX.)
+// three coordinates at once, render/integrator/path_lanes one coordinate of eight points), `scale`
+// the coordinate scale already made positive and finite: 256 ulps along n, and where
+// |p| < scale / 32 (ulps vanish near zero) scale / 65536 n. (By reference: a 32-byte vector passed by
+// value would change the ABI between code with and without AVX.)
 template <class F, class I>
-inline void offsetCoordinates(F& p, const F& n, const F& origin, const F& floatScale) {
+inline void offsetCoordinates(F& p, const F& n, const F& scale) {
   const I step = __builtin_convertvector(256.0f * n, I);
   const I negative = p < 0.0f;  // -1 where p < 0: the offset's sign flips
   const I bits = (I)p + ((step ^ negative) - negative);
-  const I nearZero = (F)((I)p & 0x7fffffff) < origin;
-  p = nearZero ? p + floatScale * n : (F)bits;
+  const I nearZero = (F)((I)p & 0x7fffffff) < scale / 32.0f;
+  p = nearZero ? p + scale / 65536.0f * n : (F)bits;
 }
 
 struct AlphaMask;  // what the cut-out filter needs to evaluate a texel
