@@ -134,11 +134,6 @@ EmitterGuide::Lane& EmitterGuide::lane() const {
   return lanes_[index];
 }
 
-uint32_t EmitterGuide::regionOf(const glm::vec3& p) const {
-  const glm::ivec3 c = glm::clamp(glm::ivec3(glm::clamp((p - low_) * perUnit_, 0.0f, float(kTargetRegions))),
-                                  glm::ivec3(0), regionsPerAxis_ - 1);
-  return uint32_t((c.z * regionsPerAxis_.y + c.y) * regionsPerAxis_.x + c.x);
-}
 
 uint32_t EmitterGuide::slotOf(uint32_t region, const LightSample& s, const glm::vec3& p) const {
   const size_t e = size_t(s.emitter);

@@ -99,6 +99,28 @@ class EmitterGuide {
       l.sumsOf(region, size_t(cells_))[slot % uint32_t(cells_)].fetch_add(uint64_t(std::min(value, kLargestRecord) * kFixedPoint),
                                                                           std::memory_order_relaxed);
   }
+  // A region's state: Undecided samples as EmitterSet and records its light samples, Default samples as
+  // EmitterSet (it decided against learning), Learned from its table.
+  enum class State : uint8_t { Undecided, Default, Learned };
+  // The regions' states, by index: the lanes' vector form of sampleStratified serves where sample() is
+  // EmitterSet's and records nothing (path_lanes.cpp).
+  const State* states() const { return state_.data(); }
+  // The region of point (x, y, z), for floats (F, I = int32_t) or vectors of them (I: their integers;
+  // toInt(t, i) truncates): regionOf's arithmetic, which the lanes share. (Results by reference: a
+  // vector returned by value would change the ABI between code with and without AVX.)
+  template <class F, class I, class ToInt>
+  void regionIndex(const F& x, const F& y, const F& z, ToInt toInt, I& region) const {
+    const F* v[3] = {&x, &y, &z};
+    I c[3];
+    for (int a = 0; a < 3; ++a) {
+      F t = (*v[a] - low_[a]) * perUnit_[a];
+      t = t > 0.0f ? t : F{};
+      t = t < float(kTargetRegions) ? t : F{} + float(kTargetRegions);
+      toInt(t, c[a]);
+      c[a] = c[a] < regionsPerAxis_[a] - 1 ? c[a] : I{} + (regionsPerAxis_[a] - 1);  // c >= 0: t was
+    }
+    region = (c[2] * regionsPerAxis_.y + c[1]) * regionsPerAxis_.x + c[0];
+  }
   // The share of regions that sample from what they learned.
   float learnedRegionShare() const;
   int regions() const { return int(state_.size()); }
@@ -131,7 +153,11 @@ class EmitterGuide {
   };
   static constexpr int kCuts = 256;
 
-  uint32_t regionOf(const glm::vec3& p) const;
+  uint32_t regionOf(const glm::vec3& p) const {
+    int32_t region;
+    regionIndex<float, int32_t>(p.x, p.y, p.z, [](float t, int32_t& i) { i = int32_t(t); }, region);
+    return uint32_t(region);
+  }
   bool grouped() const { return !groupOf_.empty(); }
   // Cell index of a point of triangle t at `square` ...
   uint32_t cellOf(size_t triangle, glm::vec2 square) const {
@@ -173,7 +199,6 @@ class EmitterGuide {
   glm::ivec3 regionsPerAxis_{1};
   glm::vec3 low_{0.0f}, perUnit_{0.0f};
   std::vector<float> base_;       // per cell: the power choice
-  enum class State : uint8_t { Undecided, Default, Learned };
   std::vector<State> state_;      // per region: Learned samples from its table, the others as EmitterSet
   std::vector<std::unique_ptr<Table>> tables_;  // per region: null until it records
   std::vector<uint64_t> attempts_, arrivals_;  // per region: every pass so far

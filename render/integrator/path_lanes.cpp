@@ -56,6 +56,22 @@ PathLanes::PathLanes(const PathTracer& tracer) : tracer_(tracer), scene_(tracer.
         for (int i = 0; i < 3; ++i) normals_.push_back(m.normals[idx[i]]);
     }
   }
+  const EmitterSet& emitters = scene_.emitters();
+  if (!emitters.foldsChoice()) return;
+  for (size_t i = 0; i < emitters.triangleCount(); ++i) {
+    const EmitterSet::TriangleLight& t = emitters.triangleLight(i);
+    if (t.textured) {
+      lights_.clear();
+      return;
+    }
+    const glm::vec3 le = data.materials[data.meshes[t.mesh].material].emission;
+    lights_.push_back({{t.p0.x, t.p0.y, t.p0.z}, {t.p1.x, t.p1.y, t.p1.z}, {t.p2.x, t.p2.y, t.p2.z},
+                       {t.normal.x, t.normal.y, t.normal.z}, {t.centre.x, t.centre.y, t.centre.z}, t.radius,
+                       t.longestEdge, t.coordinateScale, t.area, t.twoSided ? 1.0f : 0.0f, {le.x, le.y, le.z},
+                       emitters.emitterPmf(i), emitters.foldedChoice().pmf(i)});
+  }
+  const Distribution1D& choice = emitters.foldedChoice();
+  for (size_t i = 0; i <= choice.size(); ++i) lightCdf_.push_back(choice.cdf(i));
 }
 
 // The vector code below is compiled for AVX2 and FMA alone; unsupported() keeps other CPUs out.
@@ -79,6 +95,21 @@ F8 sqrt8(F8 x) { return F8(_mm256_sqrt_ps(__m256(x))); }
 F8 min8(F8 a, F8 b) { return a < b ? a : b; }
 F8 max8(F8 a, F8 b) { return a > b ? a : b; }
 F8 abs8(F8 a) { return F8(I8(a) & 0x7fffffff); }
+// Tables of up to this many entries are read by selects, not gathers: a gather costs about as much as
+// a scalar lane's light sample on the machines measured (a light of two triangles: 8 % of the time).
+constexpr int kSelectedEntries = 4;
+
+// table[index] for four indices of a table of `size` entries (the masked gather: the plain one reads
+// an undefined register).
+__m256d lookUpDoubles(const double* table, int size, __m128i index) {
+  if (size > kSelectedEntries)
+    return _mm256_mask_i32gather_pd(_mm256_setzero_pd(), table, index, _mm256_castsi256_pd(_mm256_set1_epi64x(-1)), 8);
+  __m256d v = _mm256_set1_pd(table[0]);
+  for (int i = 1; i < size; ++i)
+    v = _mm256_blendv_pd(v, _mm256_set1_pd(table[i]),
+                         _mm256_castsi256_pd(_mm256_cvtepi32_epi64(_mm_cmpeq_epi32(index, _mm_set1_epi32(i)))));
+  return v;
+}
 bool any(I8 m) { return _mm256_movemask_ps(__m256(m)) != 0; }
 int count(I8 m) { return __builtin_popcount(unsigned(_mm256_movemask_ps(__m256(m)))); }
 
@@ -197,6 +228,123 @@ class PathLanes::Batch {
   }
   glm::vec3 beta(int k) const { return {br_[k], bg_[k], bb_[k]}; }
 
+  // EmitterSet::sampleStratified from each lane's p with its numbers u, in lanes, where it folds the
+  // choice and draws an untextured triangle by area, and the guide (if any) samples as EmitterSet
+  // there: the same decisions in the same order, so the same sample up to float rounding. `served`:
+  // the lanes whose sample this is (`found`: those that have one); the others (a triangle sampled by
+  // solid angle, a punctual light or the sky, a region that learned, or one that records its samples
+  // and has one to record) call the renderer's own code.
+  struct LightLanes {
+    I8 served, found;
+    F8 wx, wy, wz, distance, r, g, b, pdf;
+  };
+  void sampleLights(F8 px, F8 py, F8 pz, F8 ux, F8 uy, LightLanes& out) const {
+    out.served = out.found = I8{};
+    if (lanes_.lights_.empty()) return;
+    I8 served = alive_, recording{};
+    if (guide_) {
+      I8 region;
+      guide_->regionIndex<F8, I8>(px, py, pz, [](const F8& t, I8& i) { i = __builtin_convertvector(t, I8); }, region);
+      const EmitterGuide::State* states = guide_->states();
+      for (int k = 0; k < kLanes; ++k) {
+        const EmitterGuide::State state = states[region[k]];
+        if (state == EmitterGuide::State::Learned) served[k] = 0;
+        if (state == EmitterGuide::State::Undecided) recording[k] = -1;
+      }
+      if (!any(served)) return;
+    }
+
+    // The folded choice (Distribution1D::sampleRange over every emitter), in doubles as there, four
+    // lanes at a time.
+    const double* cdf = lanes_.lightCdf_.data();
+    const int32_t n = int32_t(lanes_.lightCdf_.size() - 1);
+    const __m256d lo = _mm256_set1_pd(cdf[0]), span = _mm256_set1_pd(cdf[n] - cdf[0]);
+    const __m128i bits = _mm_setr_epi32(1, 2, 4, 8);
+    const auto maskOf = [&bits](__m256d m) {  // four doubles' compare mask as four ints' (0 or 1)
+      const __m128i b = _mm_and_si128(_mm_set1_epi32(_mm256_movemask_pd(m)), bits);
+      return _mm_srli_epi32(_mm_cmpeq_epi32(b, bits), 31);
+    };
+    alignas(32) int32_t chosen[kLanes];
+    alignas(32) float remappedU[kLanes];
+    for (int half = 0; half < 2; ++half) {
+      const __m128 u4 = half ? _mm256_extractf128_ps(__m256(ux), 1) : _mm256_castps256_ps128(__m256(ux));
+      const __m256d u = _mm256_min_pd(_mm256_max_pd(_mm256_cvtps_pd(u4), _mm256_setzero_pd()), _mm256_set1_pd(1.0));
+      const __m256d x = _mm256_add_pd(lo, _mm256_mul_pd(u, span));
+      __m128i base = _mm_set1_epi32(1);  // into cdf: the search runs over cdf[1, n]
+      for (int32_t m = n; m > 1;) {
+        const int32_t step = m / 2;
+        const __m128i probe = _mm_add_epi32(base, _mm_set1_epi32(step));
+        const __m256d below = _mm256_cmp_pd(lookUpDoubles(cdf, n + 1, probe), x, _CMP_LE_OQ);
+        base = _mm_add_epi32(base, _mm_mullo_epi32(maskOf(below), _mm_set1_epi32(step)));
+        m -= step;
+      }
+      const __m256d last = _mm256_cmp_pd(lookUpDoubles(cdf, n + 1, base), x, _CMP_LE_OQ);
+      __m128i index = _mm_add_epi32(_mm_sub_epi32(base, _mm_set1_epi32(1)), maskOf(last));
+      index = _mm_min_epi32(index, _mm_set1_epi32(n - 1));  // below == n: the last
+      const __m256d low = lookUpDoubles(cdf, n + 1, index);
+      const __m256d width = _mm256_sub_pd(lookUpDoubles(cdf, n + 1, _mm_add_epi32(index, _mm_set1_epi32(1))), low);
+      __m256d r = _mm256_and_pd(_mm256_div_pd(_mm256_sub_pd(x, low), width),
+                                _mm256_cmp_pd(width, _mm256_setzero_pd(), _CMP_GT_OQ));
+      r = _mm256_min_pd(_mm256_max_pd(r, _mm256_setzero_pd()), _mm256_set1_pd(double(0x1.fffffep-1f)));
+      _mm_store_si128(reinterpret_cast<__m128i*>(chosen + 4 * half), index);
+      _mm_store_ps(remappedU + 4 * half, _mm256_cvtpd_ps(r));
+    }
+    const I8 index = *reinterpret_cast<const I8*>(chosen);
+    const F8 u0 = *reinterpret_cast<const F8*>(remappedU);
+    served &= index < int32_t(lanes_.lights_.size());
+    if (!any(served)) return;
+
+    // The chosen triangle's record, field by field.
+    const I8 light = served ? index : I8{};
+    const LightRecord& r0 = lanes_.lights_[0];
+    const int lights = int(lanes_.lights_.size());
+    const auto field = [&](const float& f) {
+      constexpr int stride = int(sizeof(LightRecord) / sizeof(float));
+      if (lights > kSelectedEntries) return F8(_mm256_i32gather_ps(&f, __m256i(light * stride), 4));
+      F8 v = splat(f);
+      for (int i = 1; i < lights; ++i) v = light == i ? splat((&f)[i * stride]) : v;
+      return v;
+    };
+    served &= field(r0.foldedPmf) > 0.0f;
+    const F8 ax = field(r0.p0[0]), ay = field(r0.p0[1]), az = field(r0.p0[2]);
+    const F8 lnx = field(r0.normal[0]), lny = field(r0.normal[1]), lnz = field(r0.normal[2]);
+    const I8 twoSided = field(r0.twoSided) > 0.0f;
+
+    // EmitterSet::planeDistance, then the side: p in the plane, or behind a one-sided light, gets nothing.
+    const F8 h = lnx * (px - ax) + lny * (py - ay) + lnz * (pz - az);
+    const F8 extent = max8(field(r0.coordinateScale), max8(abs8(px), max8(abs8(py), abs8(pz))));
+    I8 found = served & (abs8(h) > EmitterSet::kPlaneTolerance * extent) & ((h > 0.0f) | twoSided);
+    // EmitterSet::solidAngleStrategy's test: a triangle that looks large goes to the scalar code.
+    const F8 cx = field(r0.centre[0]) - px, cy = field(r0.centre[1]) - py, cz = field(r0.centre[2]) - pz;
+    const F8 hp = abs8(lnx * (ax - px) + lny * (ay - py) + lnz * (az - pz));
+    const F8 nearest = max8(hp, sqrt8(cx * cx + cy * cy + cz * cz) - field(r0.radius));
+    served &= ~(found & (field(r0.longestEdge) > EmitterSet::kSolidAngleSpread * nearest));
+    found &= served;
+    out.served = served;
+    if (!any(found)) return;
+
+    // EmitterSet::sampleTrianglePoint: sampleUniformTriangle's point, then its direction and density.
+    const I8 below0 = u0 < uy;
+    const F8 b0 = below0 ? u0 / 2.0f : u0 - uy / 2.0f, b1 = below0 ? uy - u0 / 2.0f : uy / 2.0f;
+    const F8 bx = b1, by = 1.0f - b0 - b1, bw = 1.0f - bx - by;
+    const F8 dx = ax * bw + field(r0.p1[0]) * bx + field(r0.p2[0]) * by - px;
+    const F8 dy = ay * bw + field(r0.p1[1]) * bx + field(r0.p2[1]) * by - py;
+    const F8 dz = az * bw + field(r0.p1[2]) * bx + field(r0.p2[2]) * by - pz;
+    const F8 dist2 = dx * dx + dy * dy + dz * dz;
+    found &= dist2 > 0.0f;
+    out.distance = sqrt8(dist2);
+    out.wx = dx / out.distance, out.wy = dy / out.distance, out.wz = dz / out.distance;
+    const F8 cosLight = -(lnx * out.wx + lny * out.wy + lnz * out.wz);
+    found &= (abs8(cosLight) >= 1e-7f) & ((cosLight > 0.0f) | twoSided);
+    out.r = field(r0.emission[0]), out.g = field(r0.emission[1]), out.b = field(r0.emission[2]);
+    found &= (out.r > 0.0f) | (out.g > 0.0f) | (out.b > 0.0f);
+    out.pdf = field(r0.pmf) * dist2 / (abs8(cosLight) * field(r0.area));
+    // A recording region's sample goes to the renderer's code, which names its slot; where there is
+    // no sample there is nothing to record (a ceiling behind a one-sided light: most of such regions).
+    out.served = served & ~(found & recording);
+    out.found = found & out.served;
+  }
+
   // One vertex of every live lane: radiance()'s loop body for BSDF sampling without joins.
   void bounce() {
     const RTCScene handle = scene_.accel().handle();
@@ -293,7 +441,19 @@ class PathLanes::Batch {
         uDir0[k] = u.x, uDir1[k] = u.y;
       }
 
-    // Next-event estimation, lane by lane; the shadow rays as one packet.
+    // Next-event estimation: in lanes where sampleLights() serves, else lane by lane; the shadow rays
+    // as one packet. Both leave from the continuation's origin: the light and the continuation are on
+    // n's side (spawnShadowRay, spawnRay).
+    F8 qx = px, qy = py, qz = pz;
+    offsetRayOrigins(qx, qy, qz, nx, ny, nz, scale);
+    F8 ulx{}, uly{};
+    for (int k = 0; k < kLanes; ++k)
+      if (alive_[k]) {
+        const glm::vec2 u = numbers_[k]->lightPoint();
+        ulx[k] = u.x, uly[k] = u.y;
+      }
+    LightLanes lights;
+    sampleLights(px, py, pz, ulx, uly, lights);
     alignas(32) RTCRay8 shadow;
     alignas(32) int tested[kLanes];
     glm::vec3 contribution[kLanes];
@@ -302,11 +462,12 @@ class PathLanes::Batch {
     int shadows = 0;
     for (int k = 0; k < kLanes; ++k) {
       tested[k] = 0;
-      if (!alive_[k]) continue;
+      if (!alive_[k] || lights.served[k]) continue;
       const glm::vec3 p(px[k], py[k], pz[k]), n(nx[k], ny[k], nz[k]), ns(sx[k], sy[k], sz[k]);
       VertexSamples& u = *numbers_[k];
       const auto lightChoice = [&] { return u.lightChoice(); };
-      const auto ls = guide_ ? guide_->sample(p, u.lightPoint(), lightChoice) : emitters_.sampleStratified(p, u.lightPoint(), lightChoice);
+      const glm::vec2 uLight(ulx[k], uly[k]);
+      const auto ls = guide_ ? guide_->sample(p, uLight, lightChoice) : emitters_.sampleStratified(p, uLight, lightChoice);
       if (!ls) continue;
       // The light must be above the surface; the Lambertian lobe's eval and pdf (Bsdf::eval, Bsdf::pdf)
       // take the cosines with its frame's normal, the shading normal.
@@ -316,27 +477,60 @@ class PathLanes::Batch {
       if (cosOutgoing <= 0.0f || cosIn <= 0.0f) continue;
       const glm::vec3 f = glm::vec3(ar[k], ag[k], ab[k]) * kInvPiF * cosIn;
       if (isBlack(f)) continue;
-      ++stats_.rays;
       if (guide_) guide_->attempted(ls->guideSlot);
       SurfaceHit from;
       from.position = p, from.geometricNormal = n, from.coordinateScale = scale[k];
       const Ray r = spawnShadowRay(from, ls->wi, ls->distance);
       shadow.org_x[k] = r.origin.x, shadow.org_y[k] = r.origin.y, shadow.org_z[k] = r.origin.z;
       shadow.dir_x[k] = r.direction.x, shadow.dir_y[k] = r.direction.y, shadow.dir_z[k] = r.direction.z;
-      shadow.tnear[k] = 0.0f, shadow.tfar[k] = r.tMax, shadow.time[k] = 0.0f;
-      shadow.mask[k] = ~0u, shadow.id[k] = 0, shadow.flags[k] = 0;
+      shadow.tfar[k] = r.tMax;
       const float w = ls->delta ? 1.0f : powerHeuristic(ls->pdf, cosineHemispherePdf(cosIn));
       contribution[k] = f * ls->radiance * (w / ls->pdf);
       arrival[k] = luminance(ls->radiance) * cosReceiver / ls->pdf;
       slot[k] = ls->guideSlot;
       tested[k] = -1;
-      ++shadows;
     }
+    if (any(lights.found)) {
+      // The same as above, in lanes: the receiver's side and cosines, the lobe, the shadow ray
+      // (spawnShadowRay: aimed at the light point, stopped short by its margin), the MIS weight.
+      const F8 wx = lights.wx, wy = lights.wy, wz = lights.wz;
+      const F8 cosIn = wx * sx + wy * sy + wz * sz, cosOutgoing = -(dx_ * sx + dy_ * sy + dz_ * sz);
+      const F8 fr = ar * kInvPiF * cosIn, fg = ag * kInvPiF * cosIn, fb = ab * kInvPiF * cosIn;
+      const I8 lit = lights.found & (wx * nx + wy * ny + wz * nz > 0.0f) & (cosOutgoing > 0.0f) & (cosIn > 0.0f) &
+                     ((fr > 0.0f) | (fg > 0.0f) | (fb > 0.0f));
+      const F8 tx = px + wx * lights.distance - qx, ty = py + wy * lights.distance - qy, tz = pz + wz * lights.distance - qz;
+      const F8 length = sqrt8(tx * tx + ty * ty + tz * tz);
+      const I8 away = length > 0.0f;
+      const F8 safeLength = away ? length : splat(1.0f);
+      const F8 ex = qx - px, ey = qy - py, ez = qz - pz;
+      const F8 margin = max8(1e-4f * lights.distance, 2.0f * sqrt8(ex * ex + ey * ey + ez * ez));
+      const F8 tMax = away ? max8(F8{}, length - margin) : F8{};
+      const F8 sdx = away ? tx / safeLength : wx, sdy = away ? ty / safeLength : wy, sdz = away ? tz / safeLength : wz;
+      const F8 bsdfPdf = cosIn * kInvPi, a = lights.pdf * lights.pdf, b = bsdfPdf * bsdfPdf;
+      const F8 weight = a + b > 0.0f ? a / (a + b) : F8{};
+      const F8 share = weight / lights.pdf;
+      for (int k = 0; k < kLanes; ++k) {
+        if (!lit[k]) continue;
+        shadow.org_x[k] = qx[k], shadow.org_y[k] = qy[k], shadow.org_z[k] = qz[k];
+        shadow.dir_x[k] = sdx[k], shadow.dir_y[k] = sdy[k], shadow.dir_z[k] = sdz[k];
+        shadow.tfar[k] = tMax[k];
+        contribution[k] = glm::vec3(fr[k], fg[k], fb[k]) * glm::vec3(lights.r[k], lights.g[k], lights.b[k]) * share[k];
+        slot[k] = UINT32_MAX;
+        tested[k] = -1;
+      }
+    }
+    for (int k = 0; k < kLanes; ++k)
+      if (tested[k]) {
+        shadow.tnear[k] = 0.0f, shadow.time[k] = 0.0f;
+        shadow.mask[k] = ~0u, shadow.id[k] = 0, shadow.flags[k] = 0;
+        ++shadows;
+      }
+    stats_.rays += uint64_t(shadows);
     if (shadows > 0) {
       rtcOccluded8(tested, handle, &context, &shadow);
       for (int k = 0; k < kLanes; ++k) {
         if (!tested[k] || !(shadow.tfar[k] >= 0.0f)) continue;  // Embree sets tfar to -inf on a hit
-        if (guide_) guide_->arrived(slot[k], arrival[k]);
+        if (guide_ && slot[k] != UINT32_MAX) guide_->arrived(slot[k], arrival[k]);
         L_[k] += beta(k) * contribution[k];
       }
     }
@@ -387,8 +581,7 @@ class PathLanes::Batch {
     // spawnRay: leave by the side the direction points to (the normal's: it was tested above).
     prevX_ = px, prevY_ = py, prevZ_ = pz;
     prevPdf_ = alive_ ? z * kInvPiF : prevPdf_;
-    offsetRayOrigins(px, py, pz, nx, ny, nz, scale);
-    ox_ = alive_ ? px : ox_, oy_ = alive_ ? py : oy_, oz_ = alive_ ? pz : oz_;
+    ox_ = alive_ ? qx : ox_, oy_ = alive_ ? qy : oy_, oz_ = alive_ ? qz : oz_;
     dx_ = alive_ ? wx : dx_, dy_ = alive_ ? wy : dy_, dz_ = alive_ ? wz : dz_;
     tMax_ = alive_ ? splat(INFINITY) : tMax_;
     depth_ += alive_ & 1;

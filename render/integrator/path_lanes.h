@@ -49,6 +49,16 @@ class PathLanes {
     glm::vec3 albedo;       // the Lambertian BSDF's diffuse albedo
     float coordinateScale;  // the offsets' rounding scale (SurfaceHit::coordinateScale)
   };
+  // What next-event estimation in lanes reads of an emitting triangle (EmitterSet::TriangleLight, its
+  // material's emission and its probabilities), gathered by index: a record of floats each.
+  struct LightRecord {
+    float p0[3], p1[3], p2[3], normal[3], centre[3];
+    float radius, longestEdge, coordinateScale, area, twoSided;
+    float emission[3];
+    float pmf;        // EmitterSet's power choice, the density's factor
+    float foldedPmf;  // the folded choice's (an index of weight 0 is never chosen)
+  };
+  static_assert(sizeof(LightRecord) % sizeof(float) == 0);
   class Batch;
 
   const PathTracer& tracer_;
@@ -58,6 +68,11 @@ class PathLanes {
   std::vector<uint8_t> emits_;  // the triangle is one of EmitterSet's lights
   std::vector<uint32_t> smooth_;  // where the triangle's three vertex normals start in normals_; UINT32_MAX: none
   std::vector<glm::vec3> normals_;
+  // Empty where the lanes leave next-event estimation to EmitterSet lane by lane (the choice is not
+  // folded, or an emitter is textured); else one record per emitting triangle, and the folded choice's
+  // CDF (Distribution1D::cdf).
+  std::vector<LightRecord> lights_;
+  std::vector<double> lightCdf_;
 };
 
 }  // namespace vpl

@@ -32,7 +32,8 @@ float rangeWindow(const PunctualLight& light, float distance) {
   return w * w;
 }
 
-// When a triangle is sampled by solid angle rather than by area (solidAngleStrategy below).
+// When a triangle is sampled by solid angle rather than by area (EmitterSet::kSolidAngleSpread, used by
+// solidAngleStrategy below).
 //
 // Area sampling has the solid-angle density d^2 / (cos A) = d^3 / (h A) at a point at distance d
 // from p, with h the distance from p to the triangle's plane, so over the triangle it varies by
@@ -46,7 +47,7 @@ float rangeWindow(const PunctualLight& light, float distance) {
 // favours the far side of a light, can follow it better (direct light at a Cornell box wall point
 // 1.5 m below the light and 1 m to its side: relative variance 0.001 by area, 0.007 by solid
 // angle), so a low threshold is not free of losses either.
-constexpr float kSolidAngleSpread = 0.75f;
+
 // Guards for the spherical formulas, not for variance: below kMinSolidAngle sr (a triangle seen
 // edge-on or tiny) and within kHemisphereMargin sr of a whole hemisphere (p almost on a huge
 // triangle) the triangle is sampled by area. SphericalTriangle keeps its digits well beyond both
@@ -60,8 +61,7 @@ constexpr double kHemisphereMargin = 1e-6;
 // scale): the triangle sends it nothing. Without this, a path vertex on the back of a one-sided
 // light (its reflective side) whose hit point rounded to 1e-7 below the light's plane was lit by
 // the whole front hemisphere: by area sampling at a vanishing density that did not show, but by
-// solid angle it made fireflies of 20x the pixel above the Cornell box's light.
-constexpr float kPlaneTolerance = 1e-4f;
+// solid angle it made fireflies of 20x the pixel above the Cornell box's light. (EmitterSet::kPlaneTolerance.)
 
 float averageLuminance(const Texture& texture) {
   double sum = 0.0;

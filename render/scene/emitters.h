@@ -134,7 +134,8 @@ class EmitterSet {
   glm::vec3 sky() const { return sky_; }
   bool hasSky() const { return skyIndex_ >= 0; }
 
- private:
+  // What sample() reads of an emitting triangle. Public for the eight-lane form of sampleStratified()
+  // (render/integrator/lane_lights.h), which must decide as sample() does.
   struct TriangleLight {
     uint32_t mesh, triangle;
     float area;
@@ -147,6 +148,16 @@ class EmitterSet {
     float coordinateScale; // largest |coordinate| of the vertices
     bool textured;         // the emission has a texture (radiance varies over the triangle)
   };
+  const TriangleLight& triangleLight(size_t index) const { return triangles_[index]; }
+  // The folded samplers' choice (empty unless foldsChoice()).
+  const Distribution1D& foldedChoice() const { return foldedChoice_; }
+  // A triangle looks large from p, and is sampled by solid angle, where its longest edge exceeds this
+  // share of a lower bound on its distance (emitters.cpp says why this value) ...
+  static constexpr float kSolidAngleSpread = 0.75f;
+  // ... and p lies in its plane, and gets no light from it, within this share of the coordinate scale.
+  static constexpr float kPlaneTolerance = 1e-4f;
+
+ private:
   const SceneData* scene_ = nullptr;
   std::vector<TriangleLight> triangles_;
   std::vector<PunctualLight> punctual_;

@@ -1,6 +1,7 @@
 // brdf's eight-lane estimator (render/integrator/path_lanes.h): the same samples as radiance(), an
 // analytic furnace, and the scenes it must leave to radiance().
 #include <cmath>
+#include <string>
 #include "render/film/image_metrics.h"
 #include "render/integrator/path_lanes.h"
 #include "render/session/render_job.h"
@@ -92,6 +93,75 @@ TEST(PathLanes, SkyPointLightShadingNormalsAndThroughputRouletteAsRadiance) {
   EXPECT_GT(scalar.rays, 2 * scalar.samples);  // most samples reach the floor and bounce
   EXPECT_LT(relMse(lanes.image, scalar.image), 1e-8);
   EXPECT_NEAR(double(lanes.rays), double(scalar.rays), 1e-4 * double(scalar.rays));
+}
+
+// Next-event estimation in lanes (sampleLights: the folded choice, the plane and side tests, the point
+// by area, the shadow ray's margin, the MIS weight) against EmitterSet's, on lights the Cornell box
+// lacks: several triangles of different sizes and colours, a two-sided one seen from both sides, a
+// one-sided panel that the floor behind it sees from the back, and points close enough to a light
+// that it is sampled by solid angle (left to EmitterSet). With the learned light sampling too, whose
+// plain regions the lanes serve.
+TEST(PathLanes, LightsSampledInLanesAsEmitterSet) {
+  if (!cpuHasLanes()) GTEST_SKIP() << "this CPU has no AVX2 and FMA: the lanes never run";
+  SceneData scene;
+  scene.materials.push_back(test::lambertian(0.6f));
+  Material panel = test::lambertian(0.2f);
+  panel.doubleSided = false;
+  panel.emission = glm::vec3(4.0f, 2.0f, 1.0f);
+  scene.materials.push_back(panel);
+  Material leaf = test::lambertian(0.3f);  // two-sided
+  leaf.emission = glm::vec3(0.5f, 3.0f, 0.5f);
+  scene.materials.push_back(leaf);
+  Material strip = panel;
+  strip.emission = glm::vec3(1.0f, 1.0f, 3.0f);
+  scene.materials.push_back(strip);
+  MeshData room;
+  room.positions = {{-2, 0, -2},  {2, 0, -2},  {2, 0, 2},    {-2, 0, 2},  {-2, 2, -2},
+                    {2, 2, -2},   {-2, 2, 2},  {0.3f, 0, -2}, {0.3f, 0, 2}, {0.3f, 1, 2}, {0.3f, 1, -2}};
+  // Floor, back and left walls, and a low wall across the floor that hides most of the lights from
+  // the floor beyond it: regions there learn where their light samples arrive.
+  room.indices = {0, 2, 1, 0, 3, 2, 0, 1, 5, 0, 5, 4, 0, 4, 6, 0, 6, 3, 7, 8, 9, 7, 9, 10};
+  room.material = 0;
+  MeshData panelMesh;  // stands at z = -1 facing +z: the floor behind it sees its dark back
+  panelMesh.positions = {{-0.5f, 0.3f, -1}, {0.5f, 0.3f, -1}, {0.5f, 1.3f, -1}, {-0.5f, 1.3f, -1}};
+  panelMesh.indices = {0, 1, 2, 0, 2, 3};
+  panelMesh.material = 1;
+  MeshData leafMesh;  // a small tilted triangle above the floor, lit on both sides
+  leafMesh.positions = {{0.8f, 0.9f, 0.2f}, {1.3f, 1.2f, 0.0f}, {1.0f, 0.8f, 0.7f}};
+  leafMesh.indices = {0, 1, 2};
+  leafMesh.material = 2;
+  MeshData stripMesh;  // a long strip just above the floor, facing down: the floor beneath samples it by solid angle
+  stripMesh.positions = {{-1.8f, 0.15f, -1.5f}, {-1.6f, 0.15f, -1.5f}, {-1.6f, 0.15f, 1.5f}, {-1.8f, 0.15f, 1.5f}};
+  stripMesh.indices = {0, 2, 1, 0, 3, 2};
+  stripMesh.material = 3;
+  scene.meshes = {room, panelMesh, leafMesh, stripMesh};
+  scene.boundsMin = glm::vec3(-2, 0, -2);
+  scene.boundsMax = glm::vec3(2, 2, 2);
+  CameraData camera;
+  camera.eye = glm::vec3(0.3f, 1.6f, 3.0f);
+  camera.target = glm::vec3(-0.2f, 0.4f, -1.2f);
+  camera.yfov = 1.1f;
+  scene.camera = camera;
+  // Five emitting triangles: the lanes gather their records; without the strip, three: they select them.
+  SceneData fewer = scene;
+  fewer.meshes.pop_back();
+  RenderJobSettings s = brdf(48, 36, 32);
+  s.scenePath = "panel, leaf and strip";
+  s.tracer.roulette = RouletteRule::Sqrt;
+  for (const SceneData* lit : {&scene, &fewer})
+    for (const bool learn : {false, true}) {
+      SCOPED_TRACE(std::string(lit == &scene ? "five" : "three") + " emitting triangles, " +
+                   (learn ? "learned light sampling" : "no learning"));
+      s.tracer.learnLights = learn;
+      const auto [lanes, scalar] = withAndWithout(s, lit);
+      EXPECT_GT(meanRgb(scalar.image).x, 0.05);
+      EXPECT_LT(relMse(lanes.image, scalar.image), 1e-8);
+      EXPECT_NEAR(double(lanes.rays), double(scalar.rays), 1e-4 * double(scalar.rays));
+      if (learn) {  // some regions behind the low wall learned, the same ones with and without lanes
+        EXPECT_GT(scalar.learnedLightRegions, 0.0);
+        EXPECT_EQ(lanes.learnedLightRegions, scalar.learnedLightRegions);
+      }
+    }
 }
 
 // The VPL weight window: roulette by the VPLs' estimate, and splits whose branches a lane traces after
