@@ -152,16 +152,14 @@ class PathLanes::Batch {
   // Lane k takes the tile's next pixel, if any is left.
   void start(int k) {
     started_[k] = false;
-    if (next_ >= pixels_) return;
-    const uint32_t i = next_++;
-    const int width = x1_ - x0_;
-    x_[k] = x0_ + int(i % uint32_t(width)), y_[k] = y0_ + int(i / uint32_t(width));
-    const uint64_t pixel = uint64_t(y_[k]) * uint64_t(camera_.width()) + uint64_t(x_[k]);
-    PixelSampler& sampler = samplers_[k].emplace(seed_, pixel, pass_, true);
-    const Ray ray = camera_.generateRay(glm::vec2(float(x_[k]), float(y_[k])) + sampler.cameraJitter());
-    ox_[k] = ray.origin.x, oy_[k] = ray.origin.y, oz_[k] = ray.origin.z;
-    dx_[k] = ray.direction.x, dy_[k] = ray.direction.y, dz_[k] = ray.direction.z;
-    tMax_[k] = ray.tMax;
+    if (staged_ == stagedCount_ && !stage()) return;
+    const int j = staged_++;
+    x_[k] = stagedX_[j], y_[k] = stagedY_[j];
+    samplers_[k].emplace(*stagedSamplers_[j]);
+    const glm::vec3& eye = camera_.data().eye;
+    ox_[k] = eye.x, oy_[k] = eye.y, oz_[k] = eye.z;
+    dx_[k] = stagedDx_[j], dy_[k] = stagedDy_[j], dz_[k] = stagedDz_[j];
+    tMax_[k] = INFINITY;
     br_[k] = bg_[k] = bb_[k] = 1.0f;
     L_[k] = glm::vec3(0.0f);
     depth_[k] = 0;
@@ -170,6 +168,32 @@ class PathLanes::Batch {
     started_[k] = true;
     branchesLeft_[k] = settings_.window.maxBranches - 1;
     nextBranchId_[k] = 1;
+  }
+
+  // The tile's next kLanes pixels (fewer at its end; false: none left), ready for start(): their
+  // samplers, and their camera rays (Camera::generateRay through the sampler's cameraJitter) in lanes.
+  bool stage() {
+    staged_ = stagedCount_ = 0;
+    U64x8 keys{};
+    U8 reversed{};
+    F8 x{}, y{};
+    const int width = x1_ - x0_;
+    while (stagedCount_ < kLanes && next_ < pixels_) {
+      const uint32_t i = next_++;
+      const int j = stagedCount_++;
+      stagedX_[j] = x0_ + int(i % uint32_t(width)), stagedY_[j] = y0_ + int(i / uint32_t(width));
+      const uint64_t pixel = uint64_t(stagedY_[j]) * uint64_t(camera_.width()) + uint64_t(stagedX_[j]);
+      const PixelSampler& sampler = stagedSamplers_[j].emplace(seed_, pixel, pass_, true);
+      keys[j] = sampler.pixelKey(), reversed[j] = sampler.reversedIndex();
+      x[j] = float(stagedX_[j]), y[j] = float(stagedY_[j]);
+    }
+    if (stagedCount_ == 0) return false;
+    F8 jitterX, jitterY;
+    const U8 slot = U8{} + PixelSampler::kCameraSlot;
+    lane_sobol::point(keys, reversed, slot, jitterX, jitterY);
+    x += jitterX, y += jitterY;
+    camera_.directions(x, y, stagedDx_, stagedDy_, stagedDz_, [](const F8& v, F8& r) { r = sqrt8(v); });
+    return true;
   }
 
   // A split's branch waiting for its lane (PathTracer::radiance's Branch, without joins' sums).
@@ -662,6 +686,12 @@ class PathLanes::Batch {
   PathStats& stats_;
   uint64_t& discarded_;
   uint32_t next_ = 0, pixels_;
+
+  // The pixels stage() prepared, from staged_ on.
+  std::optional<PixelSampler> stagedSamplers_[kLanes];
+  int stagedX_[kLanes] = {}, stagedY_[kLanes] = {};
+  F8 stagedDx_{}, stagedDy_{}, stagedDz_{};
+  int staged_ = 0, stagedCount_ = 0;
 
   // Per lane: its sample, and its path's state (vectors where the arithmetic is shared).
   std::optional<PixelSampler> samplers_[kLanes];

@@ -47,6 +47,9 @@ class PixelSampler {
   // stream (benches, and as the baseline the stratified samples are measured against).
   explicit PixelSampler(Rng& rng) : independent_(&rng) {}
 
+  // The camera's slot: a stratified sampler's cameraJitter() is the point get2D gives there (the path
+  // lanes draw it for eight pixels at once, render/sampling/lane_sobol.h).
+  static constexpr uint32_t kCameraSlot = 0;
   glm::vec2 cameraJitter() { return slot2D(kCameraSlot); }
   // The preview's two choices per pass: x, the offset of its systematic cluster picks; y, the slice
   // whose clusters it uses (its own or a neighbour, so that slices blend across their borders).
@@ -110,7 +113,7 @@ class PixelSampler {
   }
 
  private:
-  static constexpr uint32_t kCameraSlot = 0, kPreviewClusterSlot = 1, kFirstVertexSlot = 2;
+  static constexpr uint32_t kPreviewClusterSlot = 1, kFirstVertexSlot = 2;
   // A vertex whose numbers come from the stratified slots, not the hashed fallback.
   bool stratified(int vertex) const { return vertex < kTabulatedVertices && !branch_ && !hashedOnly_; }
 

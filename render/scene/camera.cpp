@@ -21,11 +21,10 @@ Camera::Camera(const CameraData& data, int width, int height)
 }
 
 Ray Camera::generateRay(glm::vec2 pixel) const {
-  const float sx = (2.0f * pixel.x / float(width_) - 1.0f) * tanHalfX_;
-  const float sy = (1.0f - 2.0f * pixel.y / float(height_)) * tanHalfY_;
   Ray ray;
   ray.origin = data_.eye;
-  ray.direction = glm::normalize(forward_ + sx * right_ + sy * up_);
+  directions(pixel.x, pixel.y, ray.direction.x, ray.direction.y, ray.direction.z,
+             [](float v, float& r) { r = std::sqrt(v); });
   return ray;
 }
 

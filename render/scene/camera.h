@@ -1,5 +1,6 @@
 // Pinhole camera: primary rays through jittered pixel positions.
 #pragma once
+#include <cmath>
 #include <glm/glm.hpp>
 #include "render/scene/accel.h"
 #include "render/scene/scene_data.h"
@@ -13,6 +14,21 @@ class Camera {
 
   // Ray through image position (x, y) in pixels, (0, 0) the top-left corner of the image.
   Ray generateRay(glm::vec2 pixel) const;
+  // Its direction (d) for positions (x, y) given as floats or as vectors of floats (F: the path lanes'
+  // eight at once; squareRoot(v, r) sets r to v's square root); its origin is the eye. By reference:
+  // vectors cross no call by value.
+  template <class F, class SquareRoot>
+  void directions(const F& x, const F& y, F& dx, F& dy, F& dz, SquareRoot squareRoot) const {
+    const F sx = (2.0f * x / float(width_) - 1.0f) * tanHalfX_;
+    const F sy = (1.0f - 2.0f * y / float(height_)) * tanHalfY_;
+    dx = forward_.x + sx * right_.x + sy * up_.x;
+    dy = forward_.y + sx * right_.y + sy * up_.y;
+    dz = forward_.z + sx * right_.z + sy * up_.z;
+    F length;
+    squareRoot(dx * dx + dy * dy + dz * dz, length);
+    const F inverseLength = 1.0f / length;  // glm::normalize's
+    dx = dx * inverseLength, dy = dy * inverseLength, dz = dz * inverseLength;
+  }
 
   const CameraData& data() const { return data_; }
   int width() const { return width_; }
