@@ -1,6 +1,5 @@
 // Pinhole camera: primary rays through jittered pixel positions.
 #pragma once
-#include <cmath>
 #include <glm/glm.hpp>
 #include "render/scene/accel.h"
 #include "render/scene/scene_data.h"
