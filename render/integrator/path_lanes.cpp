@@ -534,14 +534,9 @@ class PathLanes::Batch {
       const F8 fr = ar * kInvPiF * cosIn, fg = ag * kInvPiF * cosIn, fb = ab * kInvPiF * cosIn;
       const I8 lit = lights.found & (wx * nx + wy * ny + wz * nz > 0.0f) & (cosOutgoing > 0.0f) & (cosIn > 0.0f) &
                      ((fr > 0.0f) | (fg > 0.0f) | (fb > 0.0f));
-      const F8 tx = px + wx * lights.distance - qx, ty = py + wy * lights.distance - qy, tz = pz + wz * lights.distance - qz;
-      const F8 length = sqrt8(tx * tx + ty * ty + tz * tz);
-      const I8 away = length > 0.0f;
-      const F8 safeLength = away ? length : splat(1.0f);
-      const F8 ex = qx - px, ey = qy - py, ez = qz - pz;
-      const F8 margin = max8(1e-4f * lights.distance, 2.0f * sqrt8(ex * ex + ey * ey + ez * ez));
-      const F8 tMax = away ? max8(F8{}, length - margin) : F8{};
-      const F8 sdx = away ? tx / safeLength : wx, sdy = away ? ty / safeLength : wy, sdz = away ? tz / safeLength : wz;
+      F8 sdx, sdy, sdz, tMax;
+      aimShadowRay(px, py, pz, qx, qy, qz, wx, wy, wz, lights.distance, sdx, sdy, sdz, tMax,
+                   [](const F8& v, F8& root) { root = sqrt8(v); });
       const F8 bsdfPdf = cosIn * kInvPi, a = lights.pdf * lights.pdf, b = bsdfPdf * bsdfPdf;
       const F8 weight = a + b > 0.0f ? a / (a + b) : F8{};
       const F8 share = weight / lights.pdf;

@@ -115,23 +115,9 @@ Ray spawnRay(const SurfaceHit& from, const glm::vec3& wi) {
 Ray spawnShadowRay(const SurfaceHit& from, const glm::vec3& wi, float distance) {
   Ray r = spawnRay(from, wi);
   if (!std::isfinite(distance)) return r;
-  // Aimed from the offset origin at the light point itself: a ray parallel to wi from there meets a
-  // light seen at a grazing angle up to offset / sin(angle) before the point, on the light's own
-  // surface (a ceiling 0.15 m above a globe lamp of 528 facets: a fifth of the shadow rays ended on
-  // the lamp, the ceiling 3.6 % too dark). Then stop short of the point by a margin that covers both a
-  // relative error of the distance and the light's own surface offset (coordinates there are of the
-  // same size as here). A margin of the distance alone let rays between close, parallel surfaces far
-  // from the origin end on the light itself.
-  const glm::vec3 toTarget = from.position + wi * distance - r.origin;
-  const float length = glm::length(toTarget);
-  if (!(length > 0.0f)) {
-    r.tMax = 0.0f;
-    return r;
-  }
-  r.direction = toTarget / length;
-  const float offset = glm::length(r.origin - from.position);
-  const float margin = std::max(1e-4f * distance, 2.0f * offset);
-  r.tMax = std::max(0.0f, length - margin);
+  const glm::vec3& p = from.position;
+  aimShadowRay(p.x, p.y, p.z, r.origin.x, r.origin.y, r.origin.z, wi.x, wi.y, wi.z, distance, r.direction.x,
+               r.direction.y, r.direction.z, r.tMax, [](float v, float& root) { root = std::sqrt(v); });
   return r;
 }
 
