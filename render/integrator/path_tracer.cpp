@@ -34,17 +34,21 @@ float cameraMisPdf(int depth, ContinuationSampler& continuation, const SurfaceHi
   return depth == 0 ? continuation.pdf(surface, bsdf, wo, wi) : bsdf.pdf(wo, wi);
 }
 
-// The camera side's MIS partial sums after it samples `dir` at a vertex (Georgiev 2012, eq. 34-35).
-void advanceConnectionMis(float& dVC, float& dVCM, int depth, const SurfaceHit& surface, const Bsdf& bsdf,
-                          const glm::vec3& wo, const DirectionSample& dir) {
+}  // namespace
+
+void PathTracer::MisSums::arrive(float distance, float cosHit) {
+  dVCM *= connectionMis(distance * distance) / connectionMis(cosHit);
+  dVC /= connectionMis(cosHit);
+}
+
+void PathTracer::MisSums::advance(int depth, const SurfaceHit& surface, const Bsdf& bsdf, const glm::vec3& wo,
+                                  const DirectionSample& dir) {
   // The sample's own pdf is the BSDF's wherever the strategy left its weight (an unguided vertex).
   const float pdf = depth == 0 || dir.weight.x >= 0.0f ? dir.pdf : bsdf.pdf(wo, dir.wi);
   const float cosOut = std::abs(glm::dot(surface.geometricNormal, dir.wi));
   dVC = connectionMis(cosOut / pdf) * (dVC * connectionMis(bsdf.pdf(dir.wi, wo)) + dVCM);
   dVCM = connectionMis(1.0f / pdf);
 }
-
-}  // namespace
 
 std::string PathTracerSettings::validate() const {
   if (maxDepth < 1 || maxDepth > 1024) return "max depth must be between 1 and 1024";
@@ -85,9 +89,8 @@ float PathTracer::predictedRadiance(const glm::vec3& position, const glm::vec3& 
 struct PathTracer::Branch {
   Ray ray;
   glm::vec3 beta{1.0f};
-  glm::vec3 previousPosition{0.0f};  // where the ray that is traced left (a surface: the camera's is never needed)
-  float previousPdf = 0.0f;
-  int depth = 0;
+  // previousPosition: where the ray that is traced left (a surface: the camera's is never needed)
+  PathPoint at;
   PixelSampler sampler;
   MisSums mis, alt;  // connections' partial sums: the pass's join depth's and a counterfactual one's
 };
@@ -96,7 +99,7 @@ float PathTracer::nextEventPdf(const glm::vec3& p, const SurfaceHit& hit) const 
   return emitterGuide_ ? emitterGuide_->pdf(p, hit) : scene_.emitters().pdfTriangle(p, hit);
 }
 
-float PathTracer::emitterHitWeight(const SurfaceHit& surface, const glm::vec3& wo, const Branch& path,
+float PathTracer::emitterHitWeight(const SurfaceHit& surface, const glm::vec3& wo, const PathPoint& path,
                                    const MisSums& sums) const {
   if (path.depth == 0) return 1.0f;
   const EmitterSet& emitters = scene_.emitters();
@@ -108,11 +111,11 @@ float PathTracer::emitterHitWeight(const SurfaceHit& surface, const glm::vec3& w
 }
 
 float PathTracer::nextEventWeight(const LightSample& ls, const SurfaceHit& surface, const Bsdf& bsdf, const glm::vec3& wo,
-                                  const Branch& path, const MisSums& sums, ContinuationSampler& continuation) const {
+                                  int depth, const MisSums& sums, ContinuationSampler& continuation) const {
   if (!connections_) return ls.delta ? 1.0f : powerHeuristic(ls.pdf, continuation.pdf(surface, bsdf, wo, ls.wi));
   // Densities of punctual lights in the solid angle of the point they sit at (Georgiev 2012).
   const float directPdf = ls.delta && std::isfinite(ls.distance) ? ls.pdf * ls.distance * ls.distance : ls.pdf;
-  const float wLight = ls.delta ? 0.0f : connectionMis(cameraMisPdf(path.depth, continuation, surface, bsdf, wo, ls.wi) / directPdf);
+  const float wLight = ls.delta ? 0.0f : connectionMis(cameraMisPdf(depth, continuation, surface, bsdf, wo, ls.wi) / directPdf);
   // The light path that starts at the sampled point and reaches here, then shifts along the camera side.
   const float cameraSide = sums.dVCM + (sums.dVC > 0.0f ? sums.dVC * connectionMis(bsdf.pdf(ls.wi, wo)) : 0.0f);
   const float cosCamera = std::abs(glm::dot(surface.geometricNormal, ls.wi));
@@ -120,10 +123,10 @@ float PathTracer::nextEventWeight(const LightSample& ls, const SurfaceHit& surfa
   return bidirectionalWeight(wLight + wCamera);
 }
 
-glm::vec3 PathTracer::unoccludedJoin(const SurfaceHit& surface, const Bsdf& bsdf, const glm::vec3& wo, const Branch& path,
-                                     ContinuationSampler& continuation, const LightVertex& y, float scale,
-                                     Ray& shadow, int altLimit, glm::vec3& altJoined) const {
-  if (path.depth + 1 + y.length > settings_.maxDepth) return glm::vec3(0.0f);
+glm::vec3 PathTracer::unoccludedJoin(const SurfaceHit& surface, const Bsdf& bsdf, const glm::vec3& wo, int depth,
+                                     const MisSums& mis, const MisSums& alt, ContinuationSampler& continuation,
+                                     const LightVertex& y, float scale, Ray& shadow, int altLimit, glm::vec3& altJoined) const {
+  if (depth + 1 + y.length > settings_.maxDepth) return glm::vec3(0.0f);
   const glm::vec3 d = y.position - surface.position;
   const float dist2 = glm::dot(d, d);
   if (!(dist2 > 0.0f)) return glm::vec3(0.0f);
@@ -140,11 +143,11 @@ glm::vec3 PathTracer::unoccludedJoin(const SurfaceHit& surface, const Bsdf& bsdf
   // The camera's density is cameraMisPdf's, with the BSDF's taken from the evaluation above. At the
   // first vertex the camera side has no other strategy (no light tracing to the camera): cameraSide
   // is 0 and its densities are not needed.
-  const float cameraPdf = path.depth == 0 ? continuation.pdf(surface, bsdf, wo, w) : camera.pdf;
+  const float cameraPdf = depth == 0 ? continuation.pdf(surface, bsdf, wo, w) : camera.pdf;
   // The reverse densities, evaluated once when either weight needs them (a counterfactual's too).
   float reverseCamera = -1.0f, reverseLight = -1.0f;
   const auto weightFor = [&](const MisSums& sums, int limit) {
-    const float wLight = connectionMis(cameraPdf * cosLight / dist2) * LightVertexCache::lightSideSum(y, path.depth, light.pdf, limit);
+    const float wLight = connectionMis(cameraPdf * cosLight / dist2) * LightVertexCache::lightSideSum(y, depth, light.pdf, limit);
     if (sums.dVC > 0.0f && reverseCamera < 0.0f) reverseCamera = connectionMis(bsdf.pdf(w, wo));
     const float cameraSide = sums.dVCM + (sums.dVC > 0.0f ? sums.dVC * reverseCamera : 0.0f);
     if (cameraSide > 0.0f && reverseLight < 0.0f) reverseLight = connectionMis(y.bsdf.pdf(y.wIn, -w) * cosCamera / dist2);
@@ -152,11 +155,11 @@ glm::vec3 PathTracer::unoccludedJoin(const SurfaceHit& surface, const Bsdf& bsdf
     // Over this join's own count (the other joins' counts are in the partial sums).
     return bidirectionalWeight((wLight + wCamera) / connections_->misFactor(y));
   };
-  const float weight = weightFor(path.mis, connections_->joinDepth());
+  const float weight = weightFor(mis, connections_->joinDepth());
   if (!(weight > 0.0f)) return glm::vec3(0.0f);
   shadow = spawnShadowRay(surface, w, dist);
-  if (altLimit != kNoCounterfactual && LightVertexCache::joinsAt(path.depth, altLimit))
-    altJoined = camera.f * light.f * y.alpha * (cosLight / dist2 * scale * weightFor(path.alt, altLimit));
+  if (altLimit != kNoCounterfactual && LightVertexCache::joinsAt(depth, altLimit))
+    altJoined = camera.f * light.f * y.alpha * (cosLight / dist2 * scale * weightFor(alt, altLimit));
   return camera.f * light.f * y.alpha * (cosLight / dist2 * scale * weight);
 }
 
@@ -177,11 +180,11 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
   float pixelEstimate = 0.0f;  // the weight window's reference, set at the camera ray's hit
   glm::vec3 firstContinuationStart(0.0f);  // L before the first vertex's continuation
 
-  Branch path{cameraRay, glm::vec3(1.0f), glm::vec3(0.0f), 0.0f, 0, sampler, {}, {}};
+  Branch path{cameraRay, glm::vec3(1.0f), {}, sampler, {}, {}};
   for (;;) {
     Ray& ray = path.ray;
     glm::vec3& beta = path.beta;
-    const int depth = path.depth;
+    const int depth = path.at.depth;
     bool ended = true;
     do {
       VertexSamples u(path.sampler, depth);
@@ -194,9 +197,9 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
         if (emitters.hasSky()) {
           float w = 1.0f;
           if (depth > 0) {
-            const float skyPdf = emitterGuide_ ? emitterGuide_->pdfSky(path.previousPosition, ray.direction)
+            const float skyPdf = emitterGuide_ ? emitterGuide_->pdfSky(path.at.previousPosition, ray.direction)
                                                : emitters.pdfSky(ray.direction);
-            w = powerHeuristic(path.previousPdf, skyPdf);
+            w = powerHeuristic(path.at.previousPdf, skyPdf);
           }
           L += beta * emitters.sky() * w;
         }
@@ -208,21 +211,16 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
       if (connections_) {
         const float cosHit = std::abs(glm::dot(surface.geometricNormal, wo));
         if (!(cosHit > 0.0f)) break;
-        const float grow = connectionMis(hit.t * hit.t) / connectionMis(cosHit), shrink = connectionMis(cosHit);
-        path.mis.dVCM *= grow;
-        path.mis.dVC /= shrink;
-        if (alt) {
-          path.alt.dVCM *= grow;
-          path.alt.dVC /= shrink;
-        }
+        path.mis.arrive(hit.t, cosHit);
+        if (alt) path.alt.arrive(hit.t, cosHit);
       }
 
       // Emitter hit, weighted against next-event estimation of the same triangle (and, with
       // connections, against every join that makes the same path).
       const glm::vec3 le = emitters.emitted(surface, wo);
       if (!isBlack(le)) {
-        L += beta * le * emitterHitWeight(surface, wo, path, path.mis);
-        if (alt) altL += beta * le * emitterHitWeight(surface, wo, path, path.alt);
+        L += beta * le * emitterHitWeight(surface, wo, path.at, path.mis);
+        if (alt) altL += beta * le * emitterHitWeight(surface, wo, path.at, path.alt);
       }
       // From here on dVCM stands for a join with its light end at this vertex (for the emitter hit
       // above, next-event estimation's sample of it), which counts as the cache's factor of joins.
@@ -282,10 +280,10 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
           if (emitterGuide_) emitterGuide_->attempted(ls->guideSlot);
           if (!scene_.accel().occluded(spawnShadowRay(surface, ls->wi, ls->distance))) {
             if (emitterGuide_) emitterGuide_->arrived(ls->guideSlot, luminance(ls->radiance) * cosReceiver / ls->pdf);
-            const float w = nextEventWeight(*ls, surface, bsdf, wo, path, path.mis, continuation);
+            const float w = nextEventWeight(*ls, surface, bsdf, wo, depth, path.mis, continuation);
             L += beta * f * ls->radiance * (w / ls->pdf);
             // At the camera ray's hit both depths' camera sums are 0, so the weights are the same.
-            if (alt) altL += beta * f * ls->radiance * ((depth == 0 ? w : nextEventWeight(*ls, surface, bsdf, wo, path, path.alt, continuation)) / ls->pdf);
+            if (alt) altL += beta * f * ls->radiance * ((depth == 0 ? w : nextEventWeight(*ls, surface, bsdf, wo, depth, path.alt, continuation)) / ls->pdf);
           }
         }
       }
@@ -295,8 +293,8 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
         const LightVertex& y = *joinTo[size_t(j)];
         Ray shadow;
         glm::vec3 altJoined(0.0f);
-        glm::vec3 joined = beta * unoccludedJoin(surface, bsdf, wo, path, continuation, y, joinScale[size_t(j)], shadow,
-                                                 altLimit, altJoined);
+        glm::vec3 joined = beta * unoccludedJoin(surface, bsdf, wo, depth, path.mis, path.alt, continuation, y,
+                                                 joinScale[size_t(j)], shadow, altLimit, altJoined);
         if (isBlack(joined)) continue;
         // Shadow-ray roulette: a join worth little against what the sample holds already rarely pays its ray.
         if (const float share = connections_->shadowRoulette(); share > 0.0f) {
@@ -321,17 +319,17 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
       // The split's other branches first (each its own numbers), then this path's own continuation.
       const glm::vec3 branchBeta = beta / float(split);
       for (int b = 1; b < split; ++b) {
-        Branch next{Ray{}, glm::vec3(0.0f), surface.position, 0.0f, depth + 1, path.sampler.branch(nextBranchId++), path.mis, path.alt};
+        Branch next{Ray{}, glm::vec3(0.0f), {depth + 1, surface.position, 0.0f}, path.sampler.branch(nextBranchId++), path.mis, path.alt};
         VertexSamples ub(next.sampler, depth);
         DirectionSample dir;
         glm::vec3 weight;
         if (!sampleContinuation(surface, bsdf, wo, ub, continuation, stats, dir, weight)) continue;
         next.beta = branchBeta * weight;
         if (!isFiniteNonNegative(next.beta)) continue;
-        if (connections_) advanceConnectionMis(next.mis.dVC, next.mis.dVCM, depth, surface, bsdf, wo, dir);
-        if (alt) advanceConnectionMis(next.alt.dVC, next.alt.dVCM, depth, surface, bsdf, wo, dir);
+        if (connections_) next.mis.advance(depth, surface, bsdf, wo, dir);
+        if (alt) next.alt.advance(depth, surface, bsdf, wo, dir);
         next.ray = spawnRay(surface, dir.wi);
-        next.previousPdf = dir.pdf;
+        next.at.previousPdf = dir.pdf;
         pending.push_back(next);
         --branchesLeft;
         ++stats.branches;
@@ -352,12 +350,10 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
         if (u.roulette() >= survive) break;
         beta /= survive;
       }
-      if (connections_) advanceConnectionMis(path.mis.dVC, path.mis.dVCM, depth, surface, bsdf, wo, next);
-      if (alt) advanceConnectionMis(path.alt.dVC, path.alt.dVCM, depth, surface, bsdf, wo, next);
-      path.previousPosition = surface.position;
-      path.previousPdf = next.pdf;
+      if (connections_) path.mis.advance(depth, surface, bsdf, wo, next);
+      if (alt) path.alt.advance(depth, surface, bsdf, wo, next);
+      path.at = {depth + 1, surface.position, next.pdf};
       ray = spawnRay(surface, next.wi);
-      path.depth = depth + 1;
       ended = false;
     } while (false);
     if (!ended) continue;

@@ -140,33 +140,48 @@ class PathTracer {
   float predictedRadiance(const glm::vec3& position, const glm::vec3& normal, const glm::vec3& reflectance) const;
   bool joinsLightVertices() const { return connections_ != nullptr; }
 
- private:
-  struct Branch;
-  // The camera side's MIS partial sums of connections (Georgiev 2012).
+ // The camera side's MIS partial sums of connections (Georgiev 2012).
   struct MisSums {
     float dVC = 0.0f, dVCM = 0.0f;  // 0 at the camera: no light tracing to it
+    // The ray that left the last vertex arrives `distance` away, at cosine `cosHit` with the surface.
+    void arrive(float distance, float cosHit);
+    // After a vertex samples `dir` (eq. 34-35); `depth` is the vertex's.
+    void advance(int depth, const SurfaceHit& surface, const Bsdf& bsdf, const glm::vec3& wo, const DirectionSample& dir);
   };
+  // Where a path stands at a vertex, for the MIS weights below: the vertex's depth, and the vertex
+  // before it with the density its continuation was sampled with.
+  struct PathPoint {
+    int depth = 0;
+    glm::vec3 previousPosition{0.0f};
+    float previousPdf = 0.0f;
+  };
+  // MIS weights of an emitter hit and of a next-event sample: against each other alone, or with
+  // connections against every join that makes the same path. `sums`: the path's own, or those of a
+  // counterfactual join depth.
+  float emitterHitWeight(const SurfaceHit& surface, const glm::vec3& wo, const PathPoint& path, const MisSums& sums) const;
+  float nextEventWeight(const LightSample& ls, const SurfaceHit& surface, const Bsdf& bsdf, const glm::vec3& wo,
+                        int depth, const MisSums& sums, ContinuationSampler& continuation) const;
+  // The MIS-weighted contribution of joining camera vertex `surface` (at `depth`, with the sums `mis`)
+  // to light vertex y, picked with weight `scale` (without the path's throughput), if `shadow`
+  // arrives; 0 when y is too long or faces away. With a counterfactual depth (`altLimit`, the sums
+  // `alt`), `altJoined` is the same join weighed for it (0 where it forbids the join, or where the
+  // join's own weight is 0 and so no ray is traced).
   static constexpr int kNoCounterfactual = -100;  // a join depth limit that stands for none
+  glm::vec3 unoccludedJoin(const SurfaceHit& surface, const Bsdf& bsdf, const glm::vec3& wo, int depth, const MisSums& mis,
+                           const MisSums& alt, ContinuationSampler& continuation, const LightVertex& y, float scale,
+                           Ray& shadow, int altLimit, glm::vec3& altJoined) const;
+  // The light vertices joined to every camera vertex (null: none).
+  const LightVertexCache* connections() const { return connections_; }
+
+ private:
+  struct Branch;
   // Radiance reflected at a vertex towards the path, as the VPLs predict it (luminance).
   float predictedRadiance(const SurfaceHit& surface, const Bsdf& bsdf) const {
     // A diffuse reflector of the BSDF's albedo at normal incidence: rough, but only ever a ratio's input.
     return predictedRadiance(surface.position, surface.geometricNormal, bsdf.params().diffuse + bsdf.params().f0);
   }
-  // MIS weights of an emitter hit and of a next-event sample: against each other alone, or with
-  // connections against every join that makes the same path.
   // Next-event estimation's solid-angle density at p of an emitter hit's point.
   float nextEventPdf(const glm::vec3& p, const SurfaceHit& hit) const;
-  // `sums`: the path's own, or those of a counterfactual join depth.
-  float emitterHitWeight(const SurfaceHit& surface, const glm::vec3& wo, const Branch& path, const MisSums& sums) const;
-  float nextEventWeight(const LightSample& ls, const SurfaceHit& surface, const Bsdf& bsdf, const glm::vec3& wo,
-                        const Branch& path, const MisSums& sums, ContinuationSampler& continuation) const;
-  // The MIS-weighted contribution of joining camera vertex `surface` to light vertex y, picked with
-  // weight `scale` (without the path's throughput), if `shadow` arrives; 0 when y is too long or faces away.
-  // With a counterfactual depth (`altLimit`), `altJoined` is the same join weighed for it (0 where it
-  // forbids the join, or where the join's own weight is 0 and so no ray is traced).
-  glm::vec3 unoccludedJoin(const SurfaceHit& surface, const Bsdf& bsdf, const glm::vec3& wo, const Branch& path,
-                           ContinuationSampler& continuation, const LightVertex& y, float scale, Ray& shadow,
-                           int altLimit, glm::vec3& altJoined) const;
 
   const RenderScene& scene_;
   PathTracerSettings settings_;
