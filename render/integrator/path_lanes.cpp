@@ -8,6 +8,7 @@
 #include <embree3/rtcore.h>
 #include "render/core/color.h"
 #include "render/guide/emitter_guide.h"
+#include "render/integrator/light_vertex_cache.h"
 #include "render/sampling/fast_trig.h"
 #include "render/sampling/lane_sobol.h"
 #include "render/sampling/pixel_sampler.h"
@@ -20,7 +21,6 @@ std::string PathLanes::unsupported(const PathTracer& tracer) {
   if (!tracer.settings().lanes) return "--lanes off";
   __builtin_cpu_init();
   if (!__builtin_cpu_supports("avx2") || !__builtin_cpu_supports("fma")) return "the CPU has no AVX2 and FMA";
-  if (tracer.joinsLightVertices()) return "VPL connections";
   const RenderScene& scene = tracer.scene();
   const SceneData& data = scene.data();
   for (const Material& m : data.materials) {
@@ -133,7 +133,7 @@ class PathLanes::Batch {
   Batch(const PathLanes& lanes, const Camera& camera, uint64_t seed, uint64_t pass, int x0, int y0, int x1, int y1,
         Film& film, PathStats& stats, uint64_t& discarded)
       : lanes_(lanes), scene_(lanes.scene_), emitters_(lanes.scene_.emitters()), guide_(lanes.tracer_.emitterGuide()),
-        settings_(lanes.tracer_.settings()), camera_(camera), seed_(seed), pass_(pass), x0_(x0), y0_(y0), x1_(x1),
+        settings_(lanes.tracer_.settings()), connections_(lanes.tracer_.connections()), camera_(camera), seed_(seed), pass_(pass), x0_(x0), y0_(y0), x1_(x1),
         film_(film), stats_(stats), discarded_(discarded), pixels_(uint32_t(x1 - x0) * uint32_t(y1 - y0)) {}
 
   void run() {
@@ -169,6 +169,7 @@ class PathLanes::Batch {
     L_[k] = glm::vec3(0.0f);
     depth_[k] = 0;
     prevPdf_[k] = 0.0f;
+    dVC_[k] = dVCM_[k] = 0.0f;
     alive_[k] = -1;
     started_[k] = true;
     branchesLeft_[k] = settings_.window.maxBranches - 1;
@@ -201,13 +202,14 @@ class PathLanes::Batch {
     return true;
   }
 
-  // A split's branch waiting for its lane (PathTracer::radiance's Branch, without joins' sums).
+  // A split's branch waiting for its lane (PathTracer::radiance's Branch, without a counterfactual's sums).
   struct Branch {
     Ray ray;
     glm::vec3 beta{0.0f}, previousPosition{0.0f};
     float previousPdf = 0.0f;
     int depth = 0;
     PixelSampler sampler;
+    PathTracer::MisSums mis;
   };
 
   // Lane k goes on with one of its sample's branches.
@@ -220,6 +222,7 @@ class PathLanes::Batch {
     prevX_[k] = b.previousPosition.x, prevY_[k] = b.previousPosition.y, prevZ_[k] = b.previousPosition.z;
     prevPdf_[k] = b.previousPdf;
     depth_[k] = b.depth;
+    dVC_[k] = b.mis.dVC, dVCM_[k] = b.mis.dVCM;
     alive_[k] = -1;
   }
 
@@ -257,6 +260,7 @@ class PathLanes::Batch {
       if (stratified[k]) numbers_[k]->drawnAhead({lightX[k], lightY[k]}, {bsdfX[k], bsdfY[k]});
   }
   glm::vec3 beta(int k) const { return {br_[k], bg_[k], bb_[k]}; }
+  PathTracer::MisSums sums(int k) const { return {dVC_[k], dVCM_[k]}; }
 
   // EmitterSet::sampleStratified from each lane's p with its numbers u, in lanes, where it folds the
   // choice and draws an untextured triangle by area, and the guide (if any) samples as EmitterSet
@@ -266,7 +270,7 @@ class PathLanes::Batch {
   // and has one to record) call the renderer's own code.
   struct LightLanes {
     I8 served, found;
-    F8 wx, wy, wz, distance, r, g, b, pdf;
+    F8 wx, wy, wz, distance, r, g, b, pdf, cosLight, emissionPdf;
   };
   void sampleLights(F8 px, F8 py, F8 pz, F8 ux, F8 uy, LightLanes& out) const {
     out.served = out.found = I8{};
@@ -368,7 +372,11 @@ class PathLanes::Batch {
     found &= (abs8(cosLight) >= 1e-7f) & ((cosLight > 0.0f) | twoSided);
     out.r = field(r0.emission[0]), out.g = field(r0.emission[1]), out.b = field(r0.emission[2]);
     found &= (out.r > 0.0f) | (out.g > 0.0f) | (out.b > 0.0f);
-    out.pdf = field(r0.pmf) * dist2 / (abs8(cosLight) * field(r0.area));
+    out.cosLight = abs8(cosLight);
+    out.pdf = field(r0.pmf) * dist2 / (out.cosLight * field(r0.area));
+    // EmitterSet::emissionPdf, for bidirectional MIS's weight.
+    if (connections_)
+      out.emissionPdf = field(r0.pmf) * out.cosLight / (std::numbers::pi_v<float> * field(r0.area) * (twoSided ? splat(2.0f) : splat(1.0f)));
     // A recording region's sample goes to the renderer's code, which names its slot; where there is
     // no sample there is nothing to record (a ceiling behind a one-sided light: most of such regions).
     out.served = served & ~(found & recording);
@@ -413,6 +421,16 @@ class PathLanes::Batch {
       if (n == glm::vec3(0.0f)) n = -d;  // degenerate, as surface() does
       const bool front = glm::dot(n, d) < 0.0f;
       if (!front) n = -n;
+      if (connections_) {  // the camera side's sums arrive here (radiance(): a grazing hit ends the path)
+        const float cosHit = std::abs(glm::dot(n, d));
+        if (!(cosHit > 0.0f)) {
+          alive_[k] = 0;
+          continue;
+        }
+        PathTracer::MisSums sums = this->sums(k);
+        sums.arrive(rh.ray.tfar[k], cosHit);
+        dVC_[k] = sums.dVC, dVCM_[k] = sums.dVCM;
+      }
       glm::vec3 ns = n;  // the shading normal, interpolated as surface() does, on n's side
       if (const uint32_t first = lanes_.smooth_[g]; first != UINT32_MAX) {
         const glm::vec3* vn = &lanes_.normals_[first];
@@ -434,6 +452,11 @@ class PathLanes::Batch {
         clearUpperHalves();
         emitted[k] = emitterHit(k, hitSurface(k, px, py, pz, nx, ny, nz, sx, sy, sz, scale, rh.hit.geomID[k], rh.hit.primID[k]));
       }
+    // From here on dVCM stands for a join with its light end at this vertex (radiance()).
+    if (connections_)
+      for (int k = 0; k < kLanes; ++k)
+        if (alive_[k])
+          dVCM_[k] *= connections_->joinsAt(depth_[k] - 1) ? connections_->misFactor(glm::vec3(px[k], py[k], pz[k])) : 0.0f;
     end(depth_ + 1 > settings_.maxDepth);
     if (!any(alive_)) return;
 
@@ -489,6 +512,27 @@ class PathLanes::Batch {
       }
     LightLanes lights;
     sampleLights(px, py, pz, ulx, uly, lights);
+    // With joins, the lanes that join here or sample their light lane by lane weigh through the
+    // tracer's own code, at their vertex's SurfaceHit and BSDF.
+    if (connections_)
+      for (int k = 0; k < kLanes; ++k) {
+        joinsHere_[k] = alive_[k] && !connections_->empty() && depth_[k] + 2 <= settings_.maxDepth &&
+                        connections_->joinsAt(depth_[k]);
+        if (joinsHere_[k]) {  // picked now: next-event estimation's shadow rays hide their fetch (radiance())
+          const int joins = connections_->joinsPerVertex();
+          const float uJoin = numbers_[k]->connectionChoice();
+          for (int j = 0; j < joins; ++j) {
+            joinTo_[k][j] = &connections_->pick((float(j) + uJoin) / float(joins), joinScale_[k][j]);
+            for (size_t line = 0; line < sizeof(LightVertex); line += 64)
+              __builtin_prefetch(reinterpret_cast<const char*>(joinTo_[k][j]) + line);
+          }
+        }
+        if (alive_[k] && (joinsHere_[k] || !lights.served[k])) {
+          clearUpperHalves();
+          surfaces_[k] = hitSurface(k, px, py, pz, nx, ny, nz, sx, sy, sz, scale, rh.hit.geomID[k], rh.hit.primID[k]);
+          bsdfs_[k].emplace(scene_.bsdf(surfaces_[k], -glm::vec3(dx_[k], dy_[k], dz_[k])));
+        }
+      }
     alignas(32) RTCRay8 shadow;
     alignas(32) int tested[kLanes];
     glm::vec3 contribution[kLanes];
@@ -520,7 +564,9 @@ class PathLanes::Batch {
       shadow.org_x[k] = r.origin.x, shadow.org_y[k] = r.origin.y, shadow.org_z[k] = r.origin.z;
       shadow.dir_x[k] = r.direction.x, shadow.dir_y[k] = r.direction.y, shadow.dir_z[k] = r.direction.z;
       shadow.tfar[k] = r.tMax;
-      const float w = ls->delta ? 1.0f : powerHeuristic(ls->pdf, cosineHemispherePdf(cosIn));
+      const float w = connections_ ? lanes_.tracer_.nextEventWeight(*ls, surfaces_[k], *bsdfs_[k], -glm::vec3(dx_[k], dy_[k], dz_[k]),
+                                                                    depth_[k], sums(k), bsdfContinuation_)
+                    : ls->delta ? 1.0f : powerHeuristic(ls->pdf, cosineHemispherePdf(cosIn));
       contribution[k] = f * ls->radiance * (w / ls->pdf);
       arrival[k] = luminance(ls->radiance) * cosReceiver / ls->pdf;
       slot[k] = ls->guideSlot;
@@ -538,7 +584,18 @@ class PathLanes::Batch {
       aimShadowRay(px, py, pz, qx, qy, qz, wx, wy, wz, lights.distance, sdx, sdy, sdz, tMax,
                    [](const F8& v, F8& root) { root = sqrt8(v); });
       const F8 bsdfPdf = cosIn * kInvPi, a = lights.pdf * lights.pdf, b = bsdfPdf * bsdfPdf;
-      const F8 weight = a + b > 0.0f ? a / (a + b) : F8{};
+      F8 weight = a + b > 0.0f ? a / (a + b) : F8{};
+      if (connections_) {
+        // PathTracer::nextEventWeight: against the continuation (the BSDF's density) and against the
+        // light paths that start at the light point and shift along the camera side (the partial sums).
+        const F8 toLight = bsdfPdf / lights.pdf;
+        const F8 reverse = cosOutgoing * kInvPiF;  // Bsdf::pdf(wi, wo): both cosines are positive here
+        const F8 cameraSide = dVCM_ + (dVC_ > 0.0f ? dVC_ * (reverse * reverse) : F8{});
+        const F8 cosCamera = abs8(wx * nx + wy * ny + wz * nz);
+        const F8 shift = lights.emissionPdf * cosCamera / (lights.pdf * lights.cosLight);
+        const F8 others = toLight * toLight + (cameraSide > 0.0f ? shift * shift * cameraSide : F8{});
+        weight = others < INFINITY ? 1.0f / (1.0f + others) : F8{};
+      }
       const F8 share = weight / lights.pdf;
       for (int k = 0; k < kLanes; ++k) {
         if (!lit[k]) continue;
@@ -565,6 +622,7 @@ class PathLanes::Batch {
         L_[k] += beta(k) * contribution[k];
       }
     }
+    if (connections_) join(handle, context);
 
     // A split's other branches, each with its own numbers, traced after this path in radiance()'s order.
     for (int k = 0; k < kLanes; ++k)
@@ -612,6 +670,15 @@ class PathLanes::Batch {
       end(killed);
     }
 
+    if (connections_) {
+      // PathTracer::MisSums::advance for the Lambertian lobe: the sample's density, and the reverse
+      // one (Bsdf::pdf(wi, wo), wo's cosine with the shading normal).
+      const F8 pdf = z * kInvPiF, reverse = -(dx_ * sx + dy_ * sy + dz_ * sz) * kInvPiF;
+      const F8 cosOut = abs8(wx * nx + wy * ny + wz * nz) / pdf, inverse = 1.0f / pdf;
+      dVC_ = alive_ ? cosOut * cosOut * (dVC_ * (reverse * reverse) + dVCM_) : dVC_;
+      dVCM_ = alive_ ? inverse * inverse : dVCM_;
+    }
+
     // spawnRay: leave by the side the direction points to (the normal's: it was tested above).
     prevX_ = px, prevY_ = py, prevZ_ = pz;
     prevPdf_ = alive_ ? z * kInvPiF : prevPdf_;
@@ -639,12 +706,8 @@ class PathLanes::Batch {
   float emitterHit(int k, const SurfaceHit& surface) {
     const glm::vec3 le = emitters_.emitted(surface, -glm::vec3(dx_[k], dy_[k], dz_[k]));
     if (isBlack(le)) return 0.0f;
-    float w = 1.0f;
-    if (depth_[k] > 0) {
-      const glm::vec3 previous(prevX_[k], prevY_[k], prevZ_[k]);
-      w = powerHeuristic(prevPdf_[k], guide_ ? guide_->pdf(previous, surface) : emitters_.pdfTriangle(previous, surface));
-    }
-    L_[k] += beta(k) * le * w;
+    const PathTracer::PathPoint at{int(depth_[k]), glm::vec3(prevX_[k], prevY_[k], prevZ_[k]), prevPdf_[k]};
+    L_[k] += beta(k) * le * lanes_.tracer_.emitterHitWeight(surface, -glm::vec3(dx_[k], dy_[k], dz_[k]), at, sums(k));
     return luminance(le);
   }
 
@@ -656,7 +719,7 @@ class PathLanes::Batch {
     const Bsdf bsdf = scene_.bsdf(surface, wo);
     const glm::vec3 share = beta(k) / float(split);
     for (int b = 1; b < split; ++b) {
-      Branch next{Ray{}, glm::vec3(0.0f), surface.position, 0.0f, depth_[k] + 1, samplers_[k]->branch(nextBranchId_[k]++)};
+      Branch next{Ray{}, glm::vec3(0.0f), surface.position, 0.0f, depth_[k] + 1, samplers_[k]->branch(nextBranchId_[k]++), sums(k)};
       VertexSamples u(next.sampler, depth_[k]);
       const auto s = bsdf.sample(wo, u.bsdfDirection());
       if (!s || !(s->pdf > 0.0f)) continue;
@@ -664,6 +727,7 @@ class PathLanes::Batch {
       if (isBlack(s->weight) || !(glm::dot(s->wi, surface.geometricNormal) > 0.0f)) continue;
       next.beta = share * s->weight;
       if (!isFiniteNonNegative(next.beta)) continue;
+      if (connections_) next.mis.advance(depth_[k], surface, bsdf, wo, DirectionSample{s->wi, s->pdf, s->weight});
       next.ray = spawnRay(surface, s->wi);
       next.previousPdf = s->pdf;
       pending_[k].push_back(next);
@@ -671,6 +735,54 @@ class PathLanes::Batch {
       ++stats_.branches;
     }
     br_[k] = share.x, bg_[k] = share.y, bb_[k] = share.z;
+  }
+
+  // Joins of every live lane's vertex to light vertices (radiance()'s, with its numbers and order): the
+  // n-th join of each lane in one packet of shadow rays, the packets in turn, as the shadow roulette
+  // weighs a join against what its sample holds after the joins before it.
+  void join(RTCScene handle, RTCIntersectContext& context) {
+    if (connections_->empty()) return;
+    const int joins = connections_->joinsPerVertex();
+    for (int j = 0; j < joins; ++j) {
+      alignas(32) RTCRay8 shadow;
+      alignas(32) int tested[kLanes];
+      glm::vec3 joined[kLanes];
+      int rays = 0;
+      for (int k = 0; k < kLanes; ++k) {
+        tested[k] = 0;
+        if (!alive_[k] || !joinsHere_[k]) continue;
+        clearUpperHalves();
+        const LightVertex& y = *joinTo_[k][j];
+        Ray r;
+        glm::vec3 unused(0.0f);
+        joined[k] = beta(k) * lanes_.tracer_.unoccludedJoin(surfaces_[k], *bsdfs_[k], -glm::vec3(dx_[k], dy_[k], dz_[k]),
+                                                          depth_[k], sums(k), sums(k), bsdfContinuation_, y, joinScale_[k][j],
+                                                          r, PathTracer::kNoCounterfactual, unused);
+        if (isBlack(joined[k])) continue;
+        if (const float share = connections_->shadowRoulette(); share > 0.0f) {
+          const float c = luminance(joined[k]), threshold = share * luminance(L_[k]);
+          if (c < threshold) {
+            const float survival = std::max(c / threshold, ConnectionSettings::kMinShadowSurvival);
+            if (numbers_[k]->random().uniform() >= survival) continue;
+            joined[k] /= survival;
+          }
+        }
+        shadow.org_x[k] = r.origin.x, shadow.org_y[k] = r.origin.y, shadow.org_z[k] = r.origin.z;
+        shadow.dir_x[k] = r.direction.x, shadow.dir_y[k] = r.direction.y, shadow.dir_z[k] = r.direction.z;
+        shadow.tnear[k] = 0.0f, shadow.tfar[k] = r.tMax, shadow.time[k] = 0.0f;
+        shadow.mask[k] = ~0u, shadow.id[k] = 0, shadow.flags[k] = 0;
+        tested[k] = -1;
+        ++rays;
+      }
+      if (rays == 0) continue;
+      stats_.rays += uint64_t(rays);
+      rtcOccluded8(tested, handle, &context, &shadow);
+      for (int k = 0; k < kLanes; ++k) {
+        if (!tested[k] || !(shadow.tfar[k] >= 0.0f)) continue;
+        connections_->record(*joinTo_[k][j], luminance(joined[k]));
+        L_[k] += joined[k];
+      }
+    }
   }
 
   // Lane k's ray left the scene: the sky, weighed against next-event estimation of the sky.
@@ -689,6 +801,8 @@ class PathLanes::Batch {
   const EmitterSet& emitters_;
   const EmitterGuide* guide_;
   const PathTracerSettings& settings_;
+  const LightVertexCache* connections_;  // null: no joins
+  BsdfContinuation bsdfContinuation_;    // the strategy the tracer's weights ask about
   const Camera& camera_;
   uint64_t seed_, pass_;
   int x0_, y0_, x1_;
@@ -713,7 +827,15 @@ class PathLanes::Batch {
   int branchesLeft_[kLanes] = {};
   uint32_t nextBranchId_[kLanes] = {};
   std::vector<Branch> pending_[kLanes];  // the sample's branches still to trace, last made first
+  // With joins: the lanes that join at this vertex, and the vertex and BSDF of those and of the
+  // lanes whose light sample is scalar.
+  bool joinsHere_[kLanes] = {};
+  const LightVertex* joinTo_[kLanes][LightVertexCache::kMaxJoinsPerVertex] = {};  // the light vertices they join
+  float joinScale_[kLanes][LightVertexCache::kMaxJoinsPerVertex] = {};
+  SurfaceHit surfaces_[kLanes];
+  std::optional<Bsdf> bsdfs_[kLanes];
   F8 ox_{}, oy_{}, oz_{}, dx_{}, dy_{}, dz_{}, tMax_{}, br_{}, bg_{}, bb_{}, prevPdf_{}, prevX_{}, prevY_{}, prevZ_{};
+  F8 dVC_{}, dVCM_{};  // with joins: the camera side's partial sums (PathTracer::MisSums)
   I8 depth_{}, alive_{};
 };
 

@@ -11,10 +11,15 @@
 // and traces them after the sample's first path, in radiance()'s order, so each branch gets the same
 // numbers and the same share of the sample's branch budget.
 //
+// Joins to light vertices (VPL connections) too: the camera side's partial sums and the bidirectional
+// MIS weights of emitter hits and light samples in lanes, the joins through the tracer's own code lane
+// by lane, their shadow rays as one packet per join. A pass that weighs a counterfactual join depth
+// (`--join-depth auto`'s trial) goes to radiance() (TileRenderer).
+//
 // Only where the vector form is the whole model (unsupported() says why not, and the caller keeps
-// radiance()): BSDF sampling, no VPL connections, every material Lambertian, untextured and opaque
-// (shading normals interpolated as RenderScene::surface does), and a CPU with AVX2 and FMA (this
-// file's vector code is compiled for them alone, and chosen at run time).
+// radiance()): BSDF sampling, every material Lambertian, untextured and opaque (shading normals
+// interpolated as RenderScene::surface does), and a CPU with AVX2 and FMA (this file's vector code
+// is compiled for them alone, and chosen at run time).
 // `--lanes off` keeps radiance() everywhere: the ablation, and what the tests compare against.
 #pragma once
 #include <cstdint>

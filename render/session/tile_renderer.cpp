@@ -33,15 +33,15 @@ int emplaceBsdfRenderer(std::optional<TileRenderer>& renderer, std::optional<Pat
   renderer.reset();  // it may read the lanes
   lanes.reset();
   if (stratified && PathLanes::unsupported(tracer).empty()) {
-    renderer.emplace(camera, seed, lanes.emplace(tracer));
+    renderer.emplace(camera, seed, lanes.emplace(tracer), pathTracerShader(tracer));
     return PathLanes::kLanes;
   }
   renderer.emplace(camera, seed, pathTracerShader(tracer), stratified);
   return 1;
 }
 
-TileRenderer::TileRenderer(const Camera& camera, uint64_t seed, const PathLanes& lanes)
-    : TileRenderer(camera, seed, PixelShaderFactory{}, true) {
+TileRenderer::TileRenderer(const Camera& camera, uint64_t seed, const PathLanes& lanes, PixelShaderFactory shader)
+    : TileRenderer(camera, seed, std::move(shader), true) {
   lanes_ = &lanes;
 }
 
@@ -55,7 +55,7 @@ PassStats TileRenderer::renderPass(Film& film, uint64_t pass, const std::atomic<
     PathStats path;
     const int x0 = (tile % tilesX_) * kTileSize, y0 = (tile / tilesX_) * kTileSize;
     const int x1 = std::min(x0 + kTileSize, width), y1 = std::min(y0 + kTileSize, height);
-    if (lanes_) {
+    if (lanes_ && !counterfactual) {
       lanes_->renderTile(camera_, seed_, pass, x0, y0, x1, y1, film, path, stats.discarded);
       stats.samples += uint64_t(x1 - x0) * uint64_t(y1 - y0);
     } else {

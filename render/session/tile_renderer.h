@@ -64,8 +64,9 @@ class TileRenderer {
 
   // `stratified` false: independent random numbers instead of the stratified sampler (PixelSampler).
   TileRenderer(const Camera& camera, uint64_t seed, PixelShaderFactory shader, bool stratified = true);
-  // `brdf` samples eight at a time: each tile through `lanes` (which must outlive the renderer).
-  TileRenderer(const Camera& camera, uint64_t seed, const PathLanes& lanes);
+  // `brdf` samples eight at a time: each tile through `lanes` (which must outlive the renderer), but
+  // a pass that weighs a counterfactual join depth through `shader` (the lanes weigh none).
+  TileRenderer(const Camera& camera, uint64_t seed, const PathLanes& lanes, PixelShaderFactory shader);
 
   // Adds one sample per pixel to film. Stops early (between tiles) when *stop becomes true.
   // `counterfactual`: also adds to it what each sample would have been with joins only up to camera
@@ -82,7 +83,7 @@ class TileRenderer {
   Camera camera_;
   uint64_t seed_;
   PixelShaderFactory shader_;
-  const PathLanes* lanes_ = nullptr;  // set: tiles go through the lanes, not shader_
+  const PathLanes* lanes_ = nullptr;  // set: tiles go through the lanes, not shader_ (but see above)
   bool stratified_;
   int tilesX_, tilesY_;
 };

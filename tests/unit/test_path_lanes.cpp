@@ -95,14 +95,11 @@ TEST(PathLanes, SkyPointLightShadingNormalsAndThroughputRouletteAsRadiance) {
   EXPECT_NEAR(double(lanes.rays), double(scalar.rays), 1e-4 * double(scalar.rays));
 }
 
-// Next-event estimation in lanes (sampleLights: the folded choice, the plane and side tests, the point
-// by area, the shadow ray's margin, the MIS weight) against EmitterSet's, on lights the Cornell box
-// lacks: several triangles of different sizes and colours, a two-sided one seen from both sides, a
-// one-sided panel that the floor behind it sees from the back, and points close enough to a light
-// that it is sampled by solid angle (left to EmitterSet). With the learned light sampling too, whose
-// plain regions the lanes serve.
-TEST(PathLanes, LightsSampledInLanesAsEmitterSet) {
-  if (!cpuHasLanes()) GTEST_SKIP() << "this CPU has no AVX2 and FMA: the lanes never run";
+// Lights the Cornell box lacks (its light is near enough to every point that EmitterSet samples it by
+// solid angle, lane by lane): several triangles of different sizes and colours, a two-sided one seen
+// from both sides, a one-sided panel that the floor behind it sees from the back, a strip near enough
+// to the floor to be sampled by solid angle, and a low wall.
+SceneData panelLeafStripRoom() {
   SceneData scene;
   scene.materials.push_back(test::lambertian(0.6f));
   Material panel = test::lambertian(0.2f);
@@ -142,13 +139,25 @@ TEST(PathLanes, LightsSampledInLanesAsEmitterSet) {
   camera.target = glm::vec3(-0.2f, 0.4f, -1.2f);
   camera.yfov = 1.1f;
   scene.camera = camera;
+  return scene;
+}
+
+// Next-event estimation in lanes (sampleLights: the folded choice, the plane and side tests, the point
+// by area, the shadow ray's margin, the MIS weight) against EmitterSet's, on lights the Cornell box
+// lacks: several triangles of different sizes and colours, a two-sided one seen from both sides, a
+// one-sided panel that the floor behind it sees from the back, and points close enough to a light
+// that it is sampled by solid angle (left to EmitterSet). With the learned light sampling too, whose
+// plain regions the lanes serve.
+TEST(PathLanes, LightsSampledInLanesAsEmitterSet) {
+  if (!cpuHasLanes()) GTEST_SKIP() << "this CPU has no AVX2 and FMA: the lanes never run";
+  const SceneData scene = panelLeafStripRoom();
   // Five emitting triangles: the lanes gather their records; without the strip, three: they select them.
   SceneData fewer = scene;
   fewer.meshes.pop_back();
   RenderJobSettings s = brdf(48, 36, 32);
   s.scenePath = "panel, leaf and strip";
   s.tracer.roulette = RouletteRule::Sqrt;
-  for (const SceneData* lit : {&scene, &fewer})
+  for (const SceneData* lit : {&scene, static_cast<const SceneData*>(&fewer)})
     for (const bool learn : {false, true}) {
       SCOPED_TRACE(std::string(lit == &scene ? "five" : "three") + " emitting triangles, " +
                    (learn ? "learned light sampling" : "no learning"));
@@ -177,6 +186,57 @@ TEST(PathLanes, WeightWindowSplitsAsRadiance) {
   EXPECT_NEAR(double(lanes.branches), double(scalar.branches), 1e-3 * double(scalar.branches));
   EXPECT_NEAR(double(lanes.rays), double(scalar.rays), 1e-3 * double(scalar.rays));
   EXPECT_LT(relMse(lanes.image, scalar.image), 1e-4);
+}
+
+// Joins to light vertices (VPL connections, `brdf --connect-paths N`): bidirectional MIS weights of
+// emitter hits and light samples (in lanes where sampleLights serves, lane by lane where not), the
+// partial sums through splits, the shadow roulette of joins, every join depth, as radiance(). With
+// the uniform choice of light vertex both draw the same joins; the learned choice sums what joins
+// brought back, which rounding moves by a unit here and there, so its images agree within noise.
+TEST(PathLanes, JoinsAsRadiance) {
+  if (!cpuHasLanes()) GTEST_SKIP() << "this CPU has no AVX2 and FMA: the lanes never run";
+  struct Case {
+    const char* scene;
+    int joinDepth;
+    RouletteRule roulette;
+    float shadowRoulette;
+    double tolerance;
+  };
+  const SceneData room = panelLeafStripRoom();
+  for (const Case& c : {Case{"cornell_box", -1, RouletteRule::Sqrt, 0.0f, 1e-10},
+                        Case{"cornell_box", 1, RouletteRule::Sqrt, 1.0f, 1e-10},
+                        Case{"door_ajar", 0, RouletteRule::Sqrt, 0.0f, 1e-6},
+                        Case{"door_ajar", -1, RouletteRule::Vpl, 1.0f, 1e-6},
+                        Case{"room", -1, RouletteRule::Sqrt, 0.0f, 1e-7},
+                        Case{"room", 1, RouletteRule::Sqrt, 1.0f, 1e-7}}) {
+    SCOPED_TRACE(std::string(c.scene) + " join depth " + std::to_string(c.joinDepth));
+    const bool built = std::string(c.scene) == "room";
+    RenderJobSettings s = brdf(48, 36, 6);
+    s.scenePath = built ? "panel, leaf and strip" : test::sourceDir() + "/scenes/" + c.scene + ".gltf";
+    s.tracer.roulette = c.roulette;
+    s.connections.paths = 512;
+    s.connections.learnChoice = false;
+    s.connections.joinDepth = c.joinDepth;
+    s.connections.shadowRoulette = c.shadowRoulette;
+    // The room's light samples in lanes: learned light sampling's first passes record every sample
+    // lane by lane.
+    s.tracer.learnLights = !built;
+    const auto [lanes, scalar] = withAndWithout(s, built ? &room : nullptr);
+    ASSERT_GT(scalar.connectionPaths, 0);
+    EXPECT_GT(meanRgb(scalar.image).y, 0.001);
+    EXPECT_LT(relMse(lanes.image, scalar.image), c.tolerance);
+    EXPECT_NEAR(double(lanes.rays), double(scalar.rays), 1e-3 * double(scalar.rays));
+    EXPECT_EQ(lanes.branches, scalar.branches);
+  }
+  // The learned choice, and --join-depth auto, whose trial passes (4 to 7) the lanes leave to
+  // radiance() (they weigh no counterfactual).
+  RenderJobSettings s = brdf(48, 36, 12);
+  s.scenePath = test::sourceDir() + "/scenes/cornell_box.gltf";
+  s.connections.paths = 512;
+  const auto [lanes, scalar] = withAndWithout(s);
+  EXPECT_NEAR(meanRgb(lanes.image).y, meanRgb(scalar.image).y, 0.01 * meanRgb(scalar.image).y);
+  EXPECT_LT(relMse(lanes.image, scalar.image), 0.01);
+  EXPECT_EQ(lanes.joinDepthChosen, scalar.joinDepthChosen);
 }
 
 // Against an answer of its own: inside a closed box of albedo rho whose walls all emit le, radiance is
