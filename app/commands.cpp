@@ -84,6 +84,8 @@ nlohmann::ordered_json summaryJson(const RenderJobSettings& s, const RenderJobRe
     if (!s.guide.learnSelection) j["bsdf_prob"] = s.guide.bsdfProbability;
     else if (r.learnedBsdfProbability >= 0.0) j["bsdf_prob"] = r.learnedBsdfProbability;
     else j["bsdf_prob"] = nullptr;
+    if (r.guideGain >= 0.0) j["guide_gain"] = r.guideGain;
+    if (s.mode == SamplingMode::Mis) j["guide_switch_pass"] = r.guideSwitchPass;
   }
   if (r.connectionPaths > 0) {
     j["connect_paths"] = r.connectionPaths;

@@ -167,6 +167,12 @@ void RenderOptions::addCommonTo(CLI::App& command) {
             "guided modes: bilinear (default): the guide's density interpolated between its cells' corners | box: "
             "constant over each cell (the paper's table)")
       ->check(CLI::IsMember({"bilinear", "box"}));
+  command.add_option_function<std::string>(
+            "--guide-switch", [this](const std::string& v) { guide.switchToLanes = v == "auto"; },
+            "mis: auto (default): after the first 8 passes, BSDF samples eight at a time in AVX2 lanes take over where "
+            "the learned BSDF probabilities forecast that the guide does not pay for its one-at-a-time paths | off: "
+            "the guide throughout (the paper's estimator)")
+      ->check(CLI::IsMember({"auto", "off"}));
   command.add_option("--mis-guide", misGuide,
                      "mis: where guide directions come from: exact (samples of the guide from the BSDF's stratified "
                      "number) | chain (the cache point's Metropolis chain, as the paper)")

@@ -251,6 +251,10 @@ int runViewer(const ViewerOptions& options) {
                     static_cast<unsigned long long>(stats.discarded), stats.rouletteWindow ? "VPL window" : settings.tracer.roulette == RouletteRule::Throughput ? "throughput" : "sqrt");
         if (stats.mode == SamplingMode::Mis && stats.learnedBsdfProbability >= 0.0)
           ImGui::Text("MIS BSDF probability: %.2f (mean learned over cache points)", stats.learnedBsdfProbability);
+        if (stats.mode == SamplingMode::Mis && stats.guideSwitchPass > 0)
+          ImGui::Text("guide: forecast gain %.2f, BSDF samples in lanes from pass %d", stats.guideGain, stats.guideSwitchPass);
+        else if (stats.mode == SamplingMode::Mis && stats.guideGain >= 0.0)
+          ImGui::Text("guide: forecast gain %.2f, kept", stats.guideGain);
         if (stats.joinDepth != SessionStats::kNoJoins)
           ImGui::Text("joins: %s%s", stats.joinDepth < 0 ? "from every vertex" : ("up to depth " + std::to_string(stats.joinDepth)).c_str(),
                       stats.joinDepthTrial ? (stats.joinDepthDecided ? " (auto: measured best)" : " (auto: trying the depths)") : "");

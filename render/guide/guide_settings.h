@@ -29,6 +29,10 @@
 //                                    Measured at equal spp (bench/measure_modes.sh scenes): guiding every vertex
 //                                    left the per-sample error unchanged (within 4 %) and cost 25-45 % more time,
 //                                    as the authors found; their choice, 1, is the default
+//   switchToLanes      bool   true   mis: once the join depth's trial is over, BSDF samples in lanes take over
+//                                    where the learned selection forecasts that the guide does not pay for
+//                                    its one-at-a-time paths (render/session/guide_switch.h); false: the guide
+//                                    throughout (--guide-switch off)
 //   spreadScale        float  2      a cluster's cone is at least atan(spreadScale x its RMS spread / distance): the
 //                                    angle its members subtend (measured: 2 cut the per-sample relMSE of `mixture`
 //                                    5x on two_rooms and 11x on the interior against 0, and left `mis` unchanged)
@@ -54,6 +58,7 @@ struct GuideSettings {
   float lookupRadiusScale = 1.5f;
   float spreadScale = 2.0f;
   int guidedVertices = 1;
+  bool switchToLanes = true;
 
   std::string validate() const {
     if (!(coneAngle > 1e-4f && coneAngle <= 3.1416f)) return "guide cone angle must be in (1e-4, pi] radians";

@@ -56,6 +56,18 @@ void SelectionLearner::update() {
   }
 }
 
+double SelectionLearner::guideGain() const {
+  double chosen = 0.0, bsdfAlone = 0.0;
+  for (size_t c = 0; c < probability_.size(); ++c) {
+    if (samples_[c] < kMinSamples) continue;
+    const auto k = size_t(std::find(kCandidates.begin(), kCandidates.end(), probability_[c]) - kCandidates.begin());
+    if (k == kCount || !std::isfinite(moment_[c][k]) || !std::isfinite(moment_[c][kCount - 1])) continue;
+    chosen += moment_[c][k];
+    bsdfAlone += moment_[c][kCount - 1];
+  }
+  return bsdfAlone > 0.0 ? chosen / bsdfAlone : -1.0;
+}
+
 double SelectionLearner::meanLearnedProbability() const {
   double sum = 0.0;
   size_t n = 0;

@@ -80,6 +80,11 @@ class SelectionLearner {
   // The mean chosen probability over cache points with enough samples (-1 if none): for the JSON
   // line and the viewer's panel.
   double meanLearnedProbability() const;
+  // What the learned probabilities gain over the BSDF alone at the first vertex: the second moment of
+  // the continuations' estimates with each cache point's chosen probability over that with the BSDF
+  // alone, summed over the cache points with enough samples (1: the guide takes nothing off; -1:
+  // no cache point has enough samples yet).
+  double guideGain() const;
 
  private:
   std::vector<float> probability_;

@@ -27,6 +27,7 @@ class FilmLearners {
   }
   // For the JSON line and the viewer's panel; -1 for a learner that is off.
   double meanBsdfProbability() const { return selection_ ? selection_->meanLearnedProbability() : -1.0; }
+  double guideGain() const { return selection_ ? selection_->guideGain() : -1.0; }
   double meanGuideShare() const { return guides_ ? guides_->meanLearnedShare() : -1.0; }
 
  private:

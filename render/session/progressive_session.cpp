@@ -11,6 +11,7 @@
 #include "render/guide/emitter_guide.h"
 #include "render/session/film_learners.h"
 #include "render/session/tile_renderer.h"
+#include "render/session/guide_switch.h"
 #include "render/session/join_depth_trial.h"
 #include "render/session/window_switch.h"
 
@@ -66,6 +67,7 @@ struct ProgressiveSession::CameraState {
     std::unique_ptr<LightVertexCache> joins;    // VPL connections: its choice of vertices learns from this film's passes
     std::unique_ptr<EmitterGuide> lights;       // learned next-event estimation, from this film's passes
     std::unique_ptr<JoinDepthTrial> joinTrial;  // --join-depth auto: which depth this film's passes join to
+    GuideSwitch guideSwitch;                    // mis: whether BSDF samples in lanes took over this film
   };
   std::optional<Request> key;
   Clock::time_point restart = Clock::now();
@@ -188,6 +190,8 @@ void ProgressiveSession::controllerLoop() {
       stats_.firstPreviewSeconds = stats_.refineStartSeconds = 0.0;
       stats_.learnedBsdfProbability = -1.0;
       stats_.learnedGuideShare = -1.0;
+      stats_.guideSwitchPass = 0;
+      stats_.guideGain = -1.0;
     }
     state.key = request;
     arena.execute([&] { runUntilChanged(state, request); });
@@ -357,7 +361,7 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
   std::optional<TileRenderer> renderer;
   std::optional<PathLanes> lanes;  // brdf's, where they apply
   const auto emplaceRenderer = [&] {
-    if (isGuided(request.mode)) {
+    if (isGuided(request.mode) && !mine.guideSwitch.on()) {
       renderer.reset();  // its shader holds the old tracer
       renderer.emplace(camera, settings_.seed, pathTracerShader(refineTracer(), continuation), settings_.stratifiedSampler);
     } else {
@@ -413,9 +417,15 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
     }
     if (mine.learners) {
       mine.learners->update();
+      if (request.mode == SamplingMode::Mis && settings_.guide.switchToLanes && !mine.guideSwitch.decided() &&
+          mine.guideSwitch.update(uint64_t(mine.complete), mine.learners->guideGain(),
+                                  settings_.stratifiedSampler && PathLanes::unsupported(refineTracer()).empty()))
+        emplaceRenderer();
       std::lock_guard lock(mutex_);
       stats_.learnedBsdfProbability = mine.learners->meanBsdfProbability();
       stats_.learnedGuideShare = mine.learners->meanGuideShare();
+      stats_.guideSwitchPass = int(mine.guideSwitch.fromPass());
+      stats_.guideGain = mine.guideSwitch.gain();
     }
     if (rule == RouletteRule::Auto && !mine.window.on() && WindowSwitch::updateDue(uint64_t(mine.complete)) &&
         mine.window.update(*mine.film)) {

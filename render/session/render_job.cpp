@@ -14,6 +14,7 @@
 #include "render/scene/camera.h"
 #include "render/scene/gltf_loader.h"
 #include "render/session/film_learners.h"
+#include "render/session/guide_switch.h"
 #include "render/session/join_depth_trial.h"
 #include "render/session/tile_renderer.h"
 #include "render/session/window_switch.h"
@@ -150,8 +151,9 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
   }
   std::optional<TileRenderer> renderer;
   std::optional<PathLanes> lanes;
+  GuideSwitch guideSwitch;  // mis: whether BSDF samples in lanes have taken over
   const auto makeRenderer = [&] {
-    if (settings.mode == SamplingMode::Brdf) {
+    if (settings.mode == SamplingMode::Brdf || guideSwitch.on()) {
       result.lanes = emplaceBsdfRenderer(renderer, lanes, camera, settings.seed, *tracer, settings.stratifiedSampler);
       return;
     }
@@ -206,6 +208,12 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
       const auto t = Clock::now();
       learners->update();
       result.timings.guideLearning += secondsSince(t);
+      if (settings.mode == SamplingMode::Mis && settings.guide.switchToLanes && !guideSwitch.decided() &&
+          guideSwitch.update(uint64_t(result.spp), learners->guideGain(),
+                             settings.stratifiedSampler && PathLanes::unsupported(*tracer).empty())) {
+        result.guideSwitchPass = result.spp;
+        makeRenderer();
+      }
     }
     if (autoRoulette && !window.on() && WindowSwitch::updateDue(uint64_t(result.spp))) {
       if (window.update(film)) {
@@ -222,6 +230,7 @@ RenderJobResult runRenderJob(const RenderJobSettings& settings, SceneData data, 
   if (emitterGuide.active()) result.learnedLightRegions = emitterGuide.learnedRegionShare();
   if (learners) {
     result.learnedBsdfProbability = learners->meanBsdfProbability();
+    result.guideGain = learners->guideGain();
     result.learnedGuideShare = learners->meanGuideShare();
   }
   if (joinTrial && joinTrial->decided()) {

@@ -62,6 +62,8 @@ struct RenderJobResult {
   std::vector<double> joinDepthScores;   // its score per candidate (JoinDepthTrial::kCandidates)
   int connectionPaths = 0;               // VPL connections: light paths per pass (0: none)
   double learnedBsdfProbability = -1.0;  // mis: the mean learned BSDF probability over cache points (-1: none)
+  double guideGain = -1.0;  // mis: SelectionLearner::guideGain at the end (-1: none)
+  int guideSwitchPass = 0;  // mis: the pass from which BSDF samples in lanes took over (0: never; guide_switch.h)
   double learnedLightRegions = -1.0;     // learned next-event estimation: the share of regions that learned (-1: off)
   int lanes = 1;                         // paths traced at once: PathLanes::kLanes where the lanes applied, else 1
   double learnedGuideShare = -1.0;       // learned guides: the mean weight of what was learned against the VPLs

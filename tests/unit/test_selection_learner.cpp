@@ -52,6 +52,24 @@ TEST(SelectionLearner, PicksTheGuideWhereTheLightFollowsItAndTheBsdfWhereItDoesN
   }
 }
 
+// The forecast of what the learned probabilities take off the BSDF's second moment (GuideSwitch reads
+// it): about the guide's own gain where the light follows the guide, 1 where it follows the BSDF,
+// -1 before any cache point has enough samples.
+TEST(SelectionLearner, ForecastsWhatTheGuideGains) {
+  const Setting s;
+  SelectionLearner guideLike(1, 1, 0.5f), bsdfLike(1, 1, 0.5f), early(1, 1, 0.5f);
+  logSamples(s, true, 0.5f, 20000, 1, guideLike.tileLog(0));
+  logSamples(s, false, 0.5f, 20000, 2, bsdfLike.tileLog(0));
+  logSamples(s, true, 0.5f, int(SelectionLearner::kMinSamples) - 1, 3, early.tileLog(0));
+  for (SelectionLearner* l : {&guideLike, &bsdfLike, &early}) l->update();
+  // A 10-degree cone against the cosine lobe: the guide-heavy mixture's moment is a small share of
+  // the BSDF's.
+  EXPECT_GT(guideLike.guideGain(), 0.0);
+  EXPECT_LT(guideLike.guideGain(), 0.2);
+  EXPECT_DOUBLE_EQ(bsdfLike.guideGain(), 1.0);
+  EXPECT_EQ(early.guideGain(), -1.0);
+}
+
 // Two kinds of sample, drawn with density 1: P where the BSDF's density is twice the guide's, Q the
 // other way round. Their second moment under candidate a is then exactly
 // nP / (0.5 + 0.5 a) + nQ / (1 - 0.5 a).
