@@ -2,7 +2,7 @@
 //
 // The guide's directions are drawn in radiance(), one path at a time; BSDF sampling runs eight paths
 // at a time in AVX2 lanes (path_lanes.h), joins and weight window included, at 0.78-0.85x the render
-// time of a guided sample on door_ajar and two_rooms (32 spp, 320x240, seeds 1 and 2, on 18ef6e3; the
+// time of a guided sample on door_ajar and two_rooms (32 spp, 320x240, seeds 1 and 2, on 190c20b; the
 // same estimator with --bsdf-prob 1: 0.97-1.02x). Where the guide takes less than that off a sample's
 // variance, the lanes' BSDF samples are the better buy. On those scenes it took nothing off: at 32
 // spp `mis` and `mis --bsdf-prob 1` had the same relMSE within the seeds' spread (door_ajar 0.0922
