@@ -247,7 +247,7 @@ int runViewer(const ViewerOptions& options) {
                     1e3 * stats.firstFrameSeconds);
         ImGui::Text("VPLs %zu (%.2f s)  clusters %.2f s  guide %.2f s  cache points %zu", stats.vpls, stats.vplSeconds,
                     stats.clusterSeconds, stats.guideSeconds, stats.cachePoints);
-        ImGui::Text("UI %.0f fps  discarded samples %llu  roulette %s", io.Framerate,
+        ImGui::Text("UI %.0f fps  paths at once %d  discarded samples %llu  roulette %s", io.Framerate, stats.lanes,
                     static_cast<unsigned long long>(stats.discarded), stats.rouletteWindow ? "VPL window" : settings.tracer.roulette == RouletteRule::Throughput ? "throughput" : "sqrt");
         if (stats.mode == SamplingMode::Mis && stats.learnedBsdfProbability >= 0.0)
           ImGui::Text("MIS BSDF probability: %.2f (mean learned over cache points)", stats.learnedBsdfProbability);

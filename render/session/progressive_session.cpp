@@ -361,12 +361,15 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
   std::optional<TileRenderer> renderer;
   std::optional<PathLanes> lanes;  // brdf's, where they apply
   const auto emplaceRenderer = [&] {
+    int paths = 1;
     if (isGuided(request.mode) && !mine.guideSwitch.on()) {
       renderer.reset();  // its shader holds the old tracer
       renderer.emplace(camera, settings_.seed, pathTracerShader(refineTracer(), continuation), settings_.stratifiedSampler);
     } else {
-      emplaceBsdfRenderer(renderer, lanes, camera, settings_.seed, refineTracer(), settings_.stratifiedSampler);
+      paths = emplaceBsdfRenderer(renderer, lanes, camera, settings_.seed, refineTracer(), settings_.stratifiedSampler);
     }
+    std::lock_guard lock(mutex_);
+    stats_.lanes = paths;
   };
   emplaceRenderer();
   const auto noteWindow = [&] {

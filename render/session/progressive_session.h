@@ -71,6 +71,7 @@ struct SessionStats {
   bool rouletteWindow = false;  // the film shown uses the VPL weight window (--roulette vpl, or auto switched)
   double learnedBsdfProbability = -1.0;  // mis: mean learned BSDF probability over cache points (-1: none yet)
   int guideSwitchPass = 0;   // mis: the pass from which BSDF samples in lanes took over (0: not, or not yet)
+  int lanes = 1;             // paths the refinement traces at once (PathLanes::kLanes where the lanes apply)
   double guideGain = -1.0;   // mis: the forecast that decided it (GuideSwitch), -1 until decided
   double learnedGuideShare = -1.0;       // learned guides: mean weight of the learned part against the prior (-1: off)
   double learnedLightRegions = -1.0;     // learned next-event estimation: the share of regions that learned (-1: off)

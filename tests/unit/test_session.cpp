@@ -13,6 +13,7 @@
 #include <thread>
 #include "render/film/image_metrics.h"
 #include "render/scene/gltf_loader.h"
+#include "render/session/guide_switch.h"
 #include "render/session/join_depth_trial.h"
 #include "render/session/progressive_session.h"
 #include "tests/unit/support.h"
@@ -103,6 +104,33 @@ TEST(Session, RandomSamplerReachesTheRefiningAndThePreviewPasses) {
     EXPECT_EQ(relMse(c, b), 0.0) << modeName(mode);
     EXPECT_EQ(random.stats().stage, SessionStage::Done) << modeName(mode);
   }
+}
+
+// mis's switch to BSDF samples in lanes in the viewer (GuideSwitch): on the Cornell box, where the
+// guide takes little off, the film's passes after the trial go to the lanes and the panel says so; with
+// --guide-switch off it keeps the guide; a camera move restarts the decision.
+TEST(Session, MisSwitchesToLanesAfterTheTrialAndARestartDecidesAgain) {
+  __builtin_cpu_init();
+  const bool lanes = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  const auto scene = cornell();
+  SessionSettings settings = small(SamplingMode::Mis, int(GuideSwitch::kDecisionPass) + 2);
+  settings.width = 96;
+  settings.height = 72;
+  ProgressiveSession session(scene, defaultCamera(scene->data()), settings);
+  const Image image = finalImage(session);
+  for (const glm::vec3& p : image.pixels) ASSERT_TRUE(std::isfinite(p.x + p.y + p.z));
+  SessionStats stats = session.stats();
+  EXPECT_GT(stats.guideGain, GuideSwitch::kLanesCostShare);
+  EXPECT_EQ(stats.guideSwitchPass, lanes ? int(GuideSwitch::kDecisionPass) : 0);
+  EXPECT_EQ(stats.lanes, lanes ? PathLanes::kLanes : 1);
+  session.setCamera(moved(defaultCamera(scene->data())));
+  finalImage(session);
+  EXPECT_EQ(session.stats().guideSwitchPass, lanes ? int(GuideSwitch::kDecisionPass) : 0);
+  settings.guide.switchToLanes = false;
+  ProgressiveSession guided(scene, defaultCamera(scene->data()), settings);
+  finalImage(guided);
+  EXPECT_EQ(guided.stats().guideSwitchPass, 0);
+  EXPECT_EQ(guided.stats().lanes, 1);
 }
 
 // `--join-depth auto` in the viewer: past the trial's passes the session has decided between the
