@@ -95,9 +95,9 @@ TEST(PathLanes, SkyPointLightShadingNormalsAndThroughputRouletteAsRadiance) {
   EXPECT_NEAR(double(lanes.rays), double(scalar.rays), 1e-4 * double(scalar.rays));
 }
 
-// Lights the Cornell box lacks (its light is near enough to every point that EmitterSet samples it by
-// solid angle, lane by lane): several triangles of different sizes and colours, a two-sided one seen
-// from both sides, a one-sided panel that the floor behind it sees from the back, a strip near enough
+// Lights the Cornell box lacks (and light samples the lanes serve in a small image's first passes,
+// where the Cornell box's regions all still record theirs lane by lane): several triangles of
+// different sizes and colours, a two-sided one seen from both sides, a one-sided panel that the floor behind it sees from the back, a strip near enough
 // to the floor to be sampled by solid angle, and a low wall.
 SceneData panelLeafStripRoom() {
   SceneData scene;
