@@ -261,6 +261,7 @@ class PathLanes::Batch {
   }
   glm::vec3 beta(int k) const { return {br_[k], bg_[k], bb_[k]}; }
   PathTracer::MisSums sums(int k) const { return {dVC_[k], dVCM_[k]}; }
+  glm::vec3 wo(int k) const { return -glm::vec3(dx_[k], dy_[k], dz_[k]); }  // back along lane k's ray
 
   // EmitterSet::sampleStratified from each lane's p with its numbers u, in lanes, where it folds the
   // choice and draws an untextured triangle by area, and the guide (if any) samples as EmitterSet
@@ -530,7 +531,7 @@ class PathLanes::Batch {
         if (alive_[k] && (joinsHere_[k] || !lights.served[k])) {
           clearUpperHalves();
           surfaces_[k] = hitSurface(k, px, py, pz, nx, ny, nz, sx, sy, sz, scale, rh.hit.geomID[k], rh.hit.primID[k]);
-          bsdfs_[k].emplace(scene_.bsdf(surfaces_[k], -glm::vec3(dx_[k], dy_[k], dz_[k])));
+          bsdfs_[k].emplace(scene_.bsdf(surfaces_[k], wo(k)));
         }
       }
     alignas(32) RTCRay8 shadow;
@@ -564,7 +565,7 @@ class PathLanes::Batch {
       shadow.org_x[k] = r.origin.x, shadow.org_y[k] = r.origin.y, shadow.org_z[k] = r.origin.z;
       shadow.dir_x[k] = r.direction.x, shadow.dir_y[k] = r.direction.y, shadow.dir_z[k] = r.direction.z;
       shadow.tfar[k] = r.tMax;
-      const float w = connections_ ? lanes_.tracer_.nextEventWeight(*ls, surfaces_[k], *bsdfs_[k], -glm::vec3(dx_[k], dy_[k], dz_[k]),
+      const float w = connections_ ? lanes_.tracer_.nextEventWeight(*ls, surfaces_[k], *bsdfs_[k], wo(k),
                                                                     depth_[k], sums(k), bsdfContinuation_)
                     : ls->delta ? 1.0f : powerHeuristic(ls->pdf, cosineHemispherePdf(cosIn));
       contribution[k] = f * ls->radiance * (w / ls->pdf);
@@ -704,10 +705,10 @@ class PathLanes::Batch {
   // An emitter hit, weighed against next-event estimation from the previous vertex; returns what the
   // emitter sends (luminance), before the weight.
   float emitterHit(int k, const SurfaceHit& surface) {
-    const glm::vec3 le = emitters_.emitted(surface, -glm::vec3(dx_[k], dy_[k], dz_[k]));
+    const glm::vec3 le = emitters_.emitted(surface, wo(k));
     if (isBlack(le)) return 0.0f;
     const PathTracer::PathPoint at{int(depth_[k]), glm::vec3(prevX_[k], prevY_[k], prevZ_[k]), prevPdf_[k]};
-    L_[k] += beta(k) * le * lanes_.tracer_.emitterHitWeight(surface, -glm::vec3(dx_[k], dy_[k], dz_[k]), at, sums(k));
+    L_[k] += beta(k) * le * lanes_.tracer_.emitterHitWeight(surface, wo(k), at, sums(k));
     return luminance(le);
   }
 
@@ -715,7 +716,7 @@ class PathLanes::Batch {
   // for later (sampleContinuation of radiance(), with the branch's own numbers), the lane's own weight
   // shrinks to its share.
   void branch(int k, int split, const SurfaceHit& surface) {
-    const glm::vec3 wo(-dx_[k], -dy_[k], -dz_[k]);
+    const glm::vec3 wo = this->wo(k);
     const Bsdf bsdf = scene_.bsdf(surface, wo);
     const glm::vec3 share = beta(k) / float(split);
     for (int b = 1; b < split; ++b) {
@@ -755,7 +756,7 @@ class PathLanes::Batch {
         const LightVertex& y = *joinTo_[k][j];
         Ray r;
         glm::vec3 unused(0.0f);
-        joined[k] = beta(k) * lanes_.tracer_.unoccludedJoin(surfaces_[k], *bsdfs_[k], -glm::vec3(dx_[k], dy_[k], dz_[k]),
+        joined[k] = beta(k) * lanes_.tracer_.unoccludedJoin(surfaces_[k], *bsdfs_[k], wo(k),
                                                           depth_[k], sums(k), sums(k), bsdfContinuation_, y, joinScale_[k][j],
                                                           r, PathTracer::kNoCounterfactual, unused);
         if (isBlack(joined[k])) continue;
