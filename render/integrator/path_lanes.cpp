@@ -513,8 +513,8 @@ class PathLanes::Batch {
       }
     LightLanes lights;
     sampleLights(px, py, pz, ulx, uly, lights);
-    // With joins, the lanes that join here or sample their light lane by lane weigh through the
-    // tracer's own code, at their vertex's SurfaceHit and BSDF.
+    // With joins, the lanes that sample their light lane by lane weigh through the tracer's own code,
+    // at their vertex's SurfaceHit and BSDF.
     if (connections_)
       for (int k = 0; k < kLanes; ++k) {
         joinsHere_[k] = alive_[k] && !connections_->empty() && depth_[k] + 2 <= settings_.maxDepth &&
@@ -528,7 +528,7 @@ class PathLanes::Batch {
               __builtin_prefetch(reinterpret_cast<const char*>(joinTo_[k][j]) + line);
           }
         }
-        if (alive_[k] && (joinsHere_[k] || !lights.served[k])) {
+        if (alive_[k] && !lights.served[k]) {
           clearUpperHalves();
           surfaces_[k] = hitSurface(k, px, py, pz, nx, ny, nz, sx, sy, sz, scale, rh.hit.geomID[k], rh.hit.primID[k]);
           bsdfs_[k].emplace(scene_.bsdf(surfaces_[k], wo(k)));
@@ -623,7 +623,7 @@ class PathLanes::Batch {
         L_[k] += beta(k) * contribution[k];
       }
     }
-    if (connections_) join(handle, context);
+    if (connections_) join(handle, context, {px, py, pz, nx, ny, nz, sx, sy, sz, ar, ag, ab, qx, qy, qz});
 
     // A split's other branches, each with its own numbers, traced after this path in radiance()'s order.
     for (int k = 0; k < kLanes; ++k)
@@ -738,27 +738,76 @@ class PathLanes::Batch {
     br_[k] = share.x, bg_[k] = share.y, bb_[k] = share.z;
   }
 
+  // The vertex that joins, in lanes: bounce()'s hit, its normals (geometric, shading), its albedo, and
+  // the origin of the rays that leave it on the geometric normal's side.
+  struct JoiningVertex {
+    const F8 &px, &py, &pz, &nx, &ny, &nz, &sx, &sy, &sz, &ar, &ag, &ab, &qx, &qy, &qz;
+  };
+
   // Joins of every live lane's vertex to light vertices (radiance()'s, with its numbers and order): the
   // n-th join of each lane in one packet of shadow rays, the packets in turn, as the shadow roulette
-  // weighs a join against what its sample holds after the joins before it.
-  void join(RTCScene handle, RTCIntersectContext& context) {
+  // weighs a join against what its sample holds after the joins before it. PathTracer::unoccludedJoin
+  // in vector form, for Lambertian lobes at both ends (every material is, where the lanes apply): each
+  // end's f and densities are its albedo and cosines (Bsdf::evalPdf, Bsdf::pdf).
+  void join(RTCScene handle, RTCIntersectContext& context, const JoiningVertex& v) {
     if (connections_->empty()) return;
-    const int joins = connections_->joinsPerVertex();
+    const int joins = connections_->joinsPerVertex(), limit = connections_->joinDepth();
+    // What every join from here shares: wo's cosine with the shading normal, the camera side's sum
+    // with its reverse density (Bsdf::pdf(w, wo)).
+    const F8 cosOutgoing = -(dx_ * v.sx + dy_ * v.sy + dz_ * v.sz);
+    const F8 reverseCamera = cosOutgoing * kInvPiF;
+    const F8 cameraSide = dVCM_ + (dVC_ > 0.0f ? dVC_ * (reverseCamera * reverseCamera) : F8{});
     for (int j = 0; j < joins; ++j) {
+      // Light vertex j of each joining lane, gathered: position, normals, its f towards the light path
+      // (its albedo over pi by wIn's cosine, times alpha), the light side's sum at its density.
+      F8 yx{}, yy{}, yz{}, gx{}, gy{}, gz{}, tx{}, ty{}, tz{}, lr{}, lg{}, lb{}, lightSide{}, factor = splat(1.0f), scale{};
+      I8 candidate{};
+      for (int k = 0; k < kLanes; ++k) {
+        if (!alive_[k] || !joinsHere_[k]) continue;
+        const LightVertex& y = *joinTo_[k][j];
+        if (depth_[k] + 1 + y.length > settings_.maxDepth) continue;
+        const glm::vec3& ns = y.bsdf.frame().n;
+        const float cosIn = glm::dot(y.wIn, ns);
+        if (!(cosIn > 0.0f)) continue;
+        const glm::vec3 f = y.bsdf.params().diffuse * kInvPiF * cosIn * y.alpha;
+        candidate[k] = -1;
+        yx[k] = y.position.x, yy[k] = y.position.y, yz[k] = y.position.z;
+        gx[k] = y.normal.x, gy[k] = y.normal.y, gz[k] = y.normal.z;
+        tx[k] = ns.x, ty[k] = ns.y, tz[k] = ns.z;
+        lr[k] = f.x, lg[k] = f.y, lb[k] = f.z;
+        lightSide[k] = LightVertexCache::lightSideSum(y, int(depth_[k]), cosIn * kInvPiF, limit);
+        factor[k] = connections_->misFactor(y);
+        scale[k] = joinScale_[k][j];
+      }
+      if (!any(candidate)) continue;
+      const F8 ex = yx - v.px, ey = yy - v.py, ez = yz - v.pz;
+      const F8 dist2 = ex * ex + ey * ey + ez * ez, dist = sqrt8(dist2);
+      const F8 wx = ex / dist, wy = ey / dist, wz = ez / dist;
+      const F8 cosCamera = wx * v.nx + wy * v.ny + wz * v.nz, cosLight = -(wx * gx + wy * gy + wz * gz);
+      const F8 cosIn = wx * v.sx + wy * v.sy + wz * v.sz, cosLightOut = -(wx * tx + wy * ty + wz * tz);
+      const F8 fr = v.ar * kInvPiF * cosIn, fg = v.ag * kInvPiF * cosIn, fb = v.ab * kInvPiF * cosIn;
+      // Both lobes' densities: the camera's towards y (the continuation's, BSDF sampling's), y's
+      // reverse one towards the camera vertex (Bsdf::pdf(wIn, -w)), each in area measure at the other end.
+      const F8 toLight = cosIn * kInvPiF * cosLight / dist2, toCamera = cosLightOut * kInvPiF * cosCamera / dist2;
+      const F8 others = (toLight * toLight * lightSide + (cameraSide > 0.0f ? toCamera * toCamera * cameraSide : F8{})) / factor;
+      const F8 weight = others < INFINITY ? 1.0f / (1.0f + others) : F8{};
+      const I8 joinable = candidate & (dist2 > 0.0f) & (cosCamera > 0.0f) & (cosLight > 0.0f) & (cosOutgoing > 0.0f) &
+                          (cosIn > 0.0f) & (cosLightOut > 0.0f) & ((fr > 0.0f) | (fg > 0.0f) | (fb > 0.0f)) &
+                          ((lr > 0.0f) | (lg > 0.0f) | (lb > 0.0f)) & (weight > 0.0f);
+      if (!any(joinable)) continue;
+      const F8 amount = cosLight / dist2 * scale * weight;
+      const F8 jr = br_ * (fr * lr * amount), jg = bg_ * (fg * lg * amount), jb = bb_ * (fb * lb * amount);
+      F8 sdx, sdy, sdz, tMax;
+      aimShadowRay(v.px, v.py, v.pz, v.qx, v.qy, v.qz, wx, wy, wz, dist, sdx, sdy, sdz, tMax,
+                   [](const F8& x, F8& root) { root = sqrt8(x); });
       alignas(32) RTCRay8 shadow;
       alignas(32) int tested[kLanes];
       glm::vec3 joined[kLanes];
       int rays = 0;
       for (int k = 0; k < kLanes; ++k) {
         tested[k] = 0;
-        if (!alive_[k] || !joinsHere_[k]) continue;
-        clearUpperHalves();
-        const LightVertex& y = *joinTo_[k][j];
-        Ray r;
-        glm::vec3 unused(0.0f);
-        joined[k] = beta(k) * lanes_.tracer_.unoccludedJoin(surfaces_[k], *bsdfs_[k], wo(k),
-                                                          depth_[k], sums(k), sums(k), bsdfContinuation_, y, joinScale_[k][j],
-                                                          r, PathTracer::kNoCounterfactual, unused);
+        if (!joinable[k]) continue;
+        joined[k] = glm::vec3(jr[k], jg[k], jb[k]);
         if (isBlack(joined[k])) continue;
         if (const float share = connections_->shadowRoulette(); share > 0.0f) {
           const float c = luminance(joined[k]), threshold = share * luminance(L_[k]);
@@ -768,9 +817,9 @@ class PathLanes::Batch {
             joined[k] /= survival;
           }
         }
-        shadow.org_x[k] = r.origin.x, shadow.org_y[k] = r.origin.y, shadow.org_z[k] = r.origin.z;
-        shadow.dir_x[k] = r.direction.x, shadow.dir_y[k] = r.direction.y, shadow.dir_z[k] = r.direction.z;
-        shadow.tnear[k] = 0.0f, shadow.tfar[k] = r.tMax, shadow.time[k] = 0.0f;
+        shadow.org_x[k] = v.qx[k], shadow.org_y[k] = v.qy[k], shadow.org_z[k] = v.qz[k];
+        shadow.dir_x[k] = sdx[k], shadow.dir_y[k] = sdy[k], shadow.dir_z[k] = sdz[k];
+        shadow.tnear[k] = 0.0f, shadow.tfar[k] = tMax[k], shadow.time[k] = 0.0f;
         shadow.mask[k] = ~0u, shadow.id[k] = 0, shadow.flags[k] = 0;
         tested[k] = -1;
         ++rays;
@@ -828,8 +877,8 @@ class PathLanes::Batch {
   int branchesLeft_[kLanes] = {};
   uint32_t nextBranchId_[kLanes] = {};
   std::vector<Branch> pending_[kLanes];  // the sample's branches still to trace, last made first
-  // With joins: the lanes that join at this vertex, and the vertex and BSDF of those and of the
-  // lanes whose light sample is scalar.
+  // With joins: the lanes that join at this vertex, and the vertex and BSDF of the lanes whose light
+  // sample is scalar.
   bool joinsHere_[kLanes] = {};
   const LightVertex* joinTo_[kLanes][LightVertexCache::kMaxJoinsPerVertex] = {};  // the light vertices they join
   float joinScale_[kLanes][LightVertexCache::kMaxJoinsPerVertex] = {};

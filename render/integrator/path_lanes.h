@@ -12,9 +12,10 @@
 // numbers and the same share of the sample's branch budget.
 //
 // Joins to light vertices (VPL connections) too: the camera side's partial sums and the bidirectional
-// MIS weights of emitter hits and light samples in lanes, the joins through the tracer's own code lane
-// by lane, their shadow rays as one packet per join. A pass that weighs a counterfactual join depth
-// (`--join-depth auto`'s trial) goes to radiance() (TileRenderer).
+// MIS weights of emitter hits and light samples in lanes, and the joins themselves in lanes (each
+// lane's light vertex gathered; both ends Lambertian, as every material is here), their shadow rays as
+// one packet per join. A pass that weighs a counterfactual join depth (`--join-depth auto`'s trial)
+// goes to radiance() (TileRenderer).
 //
 // Only where the vector form is the whole model (unsupported() says why not, and the caller keeps
 // radiance()): BSDF sampling, every material Lambertian, untextured and opaque (shading normals
