@@ -201,6 +201,7 @@ TEST(PathLanes, JoinsAsRadiance) {
     RouletteRule roulette;
     float shadowRoulette;
     double tolerance;
+    int joinsPerVertex = 2;
   };
   const SceneData room = panelLeafStripRoom();
   // The same room with shading normals that lean away from its faces': a join's cosines at the camera
@@ -214,8 +215,10 @@ TEST(PathLanes, JoinsAsRadiance) {
                         Case{"door_ajar", -1, RouletteRule::Vpl, 1.0f, 1e-6},
                         Case{"room", -1, RouletteRule::Sqrt, 0.0f, 1e-7},
                         Case{"room", 1, RouletteRule::Sqrt, 1.0f, 1e-7},
-                        Case{"leaning", -1, RouletteRule::Sqrt, 0.0f, 1e-7}}) {
-    SCOPED_TRACE(std::string(c.scene) + " join depth " + std::to_string(c.joinDepth));
+                        Case{"leaning", -1, RouletteRule::Sqrt, 0.0f, 1e-7},
+                        Case{"room", 2, RouletteRule::Sqrt, 0.0f, 1e-7, 3}}) {
+    SCOPED_TRACE(std::string(c.scene) + " join depth " + std::to_string(c.joinDepth) + ", " +
+                 std::to_string(c.joinsPerVertex) + " joins per vertex");
     const bool built = std::string(c.scene) == "room" || std::string(c.scene) == "leaning";
     RenderJobSettings s = brdf(48, 36, 6);
     s.scenePath = built ? "panel, leaf and strip" : test::sourceDir() + "/scenes/" + c.scene + ".gltf";
@@ -223,6 +226,7 @@ TEST(PathLanes, JoinsAsRadiance) {
     s.connections.paths = 512;
     s.connections.learnChoice = false;
     s.connections.joinDepth = c.joinDepth;
+    s.connections.joinsPerVertex = c.joinsPerVertex;
     s.connections.shadowRoulette = c.shadowRoulette;
     // The room's light samples in lanes: learned light sampling's first passes record every sample
     // lane by lane.
