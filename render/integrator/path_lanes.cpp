@@ -95,6 +95,9 @@ F8 sqrt8(F8 x) { return F8(_mm256_sqrt_ps(__m256(x))); }
 F8 min8(F8 a, F8 b) { return a < b ? a : b; }
 F8 max8(F8 a, F8 b) { return a > b ? a : b; }
 F8 abs8(F8 a) { return F8(I8(a) & 0x7fffffff); }
+// PathTracer's bidirectionalWeight in lanes: 1 over 1 plus the other techniques' share, 0 where that
+// share is not finite.
+F8 bidirectionalWeight8(F8 others) { return others < INFINITY ? 1.0f / (1.0f + others) : F8{}; }
 // Tables of up to this many entries are read by selects, not gathers: a gather costs about as much as
 // a scalar lane's light sample on the machines measured (a light of two triangles: 8 % of the time).
 constexpr int kSelectedEntries = 4;
@@ -595,7 +598,7 @@ class PathLanes::Batch {
         const F8 cosCamera = abs8(wx * nx + wy * ny + wz * nz);
         const F8 shift = lights.emissionPdf * cosCamera / (lights.pdf * lights.cosLight);
         const F8 others = toLight * toLight + (cameraSide > 0.0f ? shift * shift * cameraSide : F8{});
-        weight = others < INFINITY ? 1.0f / (1.0f + others) : F8{};
+        weight = bidirectionalWeight8(others);
       }
       const F8 share = weight / lights.pdf;
       for (int k = 0; k < kLanes; ++k) {
@@ -790,7 +793,7 @@ class PathLanes::Batch {
       // reverse one towards the camera vertex (Bsdf::pdf(wIn, -w)), each in area measure at the other end.
       const F8 toLight = cosIn * kInvPiF * cosLight / dist2, toCamera = cosLightOut * kInvPiF * cosCamera / dist2;
       const F8 others = (toLight * toLight * lightSide + (cameraSide > 0.0f ? toCamera * toCamera * cameraSide : F8{})) / factor;
-      const F8 weight = others < INFINITY ? 1.0f / (1.0f + others) : F8{};
+      const F8 weight = bidirectionalWeight8(others);
       const I8 joinable = candidate & (dist2 > 0.0f) & (cosCamera > 0.0f) & (cosLight > 0.0f) & (cosOutgoing > 0.0f) &
                           (cosIn > 0.0f) & (cosLightOut > 0.0f) & ((fr > 0.0f) | (fg > 0.0f) | (fb > 0.0f)) &
                           ((lr > 0.0f) | (lg > 0.0f) | (lb > 0.0f)) & (weight > 0.0f);
