@@ -19,8 +19,8 @@
 //
 // Only where the vector form is the whole model (unsupported() says why not, and the caller keeps
 // radiance()): BSDF sampling, every material Lambertian, untextured and opaque (shading normals
-// interpolated as RenderScene::surface does), and a CPU with AVX2 and FMA (this file's vector code
-// is compiled for them alone, and chosen at run time).
+// interpolated as RenderScene::surface does), and a CPU with AVX2 and FMA (the vector code, in
+// path_lanes_batch.h and the path_lane*.cpp files, is compiled for them alone, and chosen at run time).
 // `--lanes off` keeps radiance() everywhere: the ablation, and what the tests compare against.
 #pragma once
 #include <cstdint>
