@@ -35,10 +35,6 @@ __m256d lookUpDoubles(const double* table, int size, __m128i index) {
 // the lanes whose sample this is (`found`: those that have one); the others (a triangle sampled by
 // solid angle, a punctual light or the sky, a region that learned, or one that records its samples
 // and has one to record) call the renderer's own code.
-struct LightLanes {
-  I8 served, found;
-  F8 wx, wy, wz, distance, r, g, b, pdf, cosLight, emissionPdf;
-};
 void PathLanes::Batch::sampleLights(F8 px, F8 py, F8 pz, F8 ux, F8 uy, LightLanes& out) const {
   out.served = out.found = I8{};
   if (lanes_.lights_.empty()) return;
