@@ -215,58 +215,76 @@ void EmitterGuide::learnFromLastPass() {
   }
 }
 
-std::optional<LightSample> EmitterGuide::sampleLearned(const glm::vec3& p, uint32_t region, glm::vec2 u) const {
+EmitterGuide::CellPick EmitterGuide::pickCell(uint32_t region, float u) const {
   const Table& table = *tables_[region];
   const float* cdf = table.cdf.data();
-  // The first cell whose cumulative probability passes u.x (the last if none does); u.x rescaled
-  // within it serves the point.
-  uint32_t cell = table.cuts[size_t(std::min(int(u.x * float(kCuts)), kCuts - 1))];
-  while (cell + 1 < uint32_t(cells_) && cdf[cell] <= u.x) ++cell;
+  // The first cell whose cumulative probability passes u (the last if none does); u rescaled within
+  // it serves the point.
+  uint32_t cell = table.cuts[size_t(std::min(int(u * float(kCuts)), kCuts - 1))];
+  while (cell + 1 < uint32_t(cells_) && cdf[cell] <= u) ++cell;
   const float low = cell > 0 ? cdf[cell - 1] : 0.0f, width = cdf[cell] - low;
-  if (!(width > 0.0f)) return std::nullopt;
-  const float x = std::clamp((u.x - low) / width, 0.0f, std::nextafter(1.0f, 0.0f));
-  const uint32_t slot = region * uint32_t(cells_) + cell;
-  if (cell >= uint32_t(skyFirst_)) {
+  if (!(width > 0.0f)) return {cell, 0.0f, 0.0f};
+  return {cell, std::clamp((u - low) / width, 0.0f, std::nextafter(1.0f, 0.0f)), width};
+}
+
+bool EmitterGuide::trianglePoint(const CellPick& c, float v, TrianglePick& out) const {
+  if (grouped()) {
+    // A triangle of the group by its share of the group's area (x rescaled once more), then its point.
+    const uint32_t first = groupFirst_[c.cell], count = groupFirst_[c.cell + 1] - first;
+    const float* shares = groupCdf_.data() + first;
+    // The first triangle whose cumulative share passes x (the last if none does), from where it would
+    // be if the areas were equal: a step or two on a tessellated lamp.
+    uint32_t k = std::min(uint32_t(c.x * float(count)), count - 1);
+    while (k > 0 && shares[k - 1] > c.x) --k;
+    while (k + 1 < count && shares[k] <= c.x) ++k;
+    const float before = k > 0 ? shares[k - 1] : 0.0f, share = shares[k] - before;
+    if (!(share > 0.0f)) return false;
+    out.triangle = groupTriangles_[first + k];
+    out.square = glm::vec2(std::clamp((c.x - before) / share, 0.0f, std::nextafter(1.0f, 0.0f)), v);
+    out.choice = c.width * areaShare_[out.triangle];
+    return true;
+  }
+  out.triangle = c.cell / uint32_t(grid_ * grid_);
+  const uint32_t inTriangle = c.cell % uint32_t(grid_ * grid_);
+  out.square = (glm::vec2(float(inTriangle % uint32_t(grid_)), float(inTriangle / uint32_t(grid_))) + glm::vec2(c.x, v)) /
+               float(grid_);
+  out.choice = c.width * float(grid_ * grid_);
+  return true;
+}
+
+bool EmitterGuide::pickLearnedTriangle(uint32_t region, glm::vec2 u, TrianglePick& out) const {
+  const CellPick c = pickCell(region, u.x);
+  if (!(c.width > 0.0f) || c.cell >= uint32_t(punctualFirst_)) return false;
+  out.slot = region * uint32_t(cells_) + c.cell;
+  return trianglePoint(c, u.y, out);
+}
+
+std::optional<LightSample> EmitterGuide::sampleLearned(const glm::vec3& p, uint32_t region, glm::vec2 u) const {
+  const CellPick c = pickCell(region, u.x);
+  if (!(c.width > 0.0f)) return std::nullopt;
+  const uint32_t slot = region * uint32_t(cells_) + c.cell;
+  if (c.cell >= uint32_t(skyFirst_)) {
     // A direction uniform in the sky cell's solid angle (the map preserves area).
-    const uint32_t bin = cell - uint32_t(skyFirst_);
+    const uint32_t bin = c.cell - uint32_t(skyFirst_);
     const glm::vec2 square = (glm::vec2(float(bin % uint32_t(kSkyResolution)), float(bin / uint32_t(kSkyResolution))) +
-                              glm::vec2(x, u.y)) / float(kSkyResolution);
+                              glm::vec2(c.x, u.y)) / float(kSkyResolution);
     LightSample s;
     s.wi = glm::normalize(equalAreaSquareToSphere(square));
     s.radiance = scene_->emitters().sky();
-    s.pdf = width * float(kSkyResolution * kSkyResolution) / (4.0f * kPi);
+    s.pdf = c.width * float(kSkyResolution * kSkyResolution) / (4.0f * kPi);
     s.emitter = scene_->emitters().skyIndex();
     s.guideSlot = slot;
     return s;
   }
-  if (cell >= uint32_t(punctualFirst_)) {
+  if (c.cell >= uint32_t(punctualFirst_)) {
     const EmitterSet& emitters = scene_->emitters();
-    auto s = emitters.samplePunctual(p, emitters.triangleCount() + (cell - uint32_t(punctualFirst_)), width);
+    auto s = emitters.samplePunctual(p, emitters.triangleCount() + (c.cell - uint32_t(punctualFirst_)), c.width);
     if (s) s->guideSlot = slot;
     return s;
   }
-  if (grouped()) {
-    // A triangle of the group by its share of the group's area (x rescaled once more), then its point.
-    const uint32_t first = groupFirst_[cell], count = groupFirst_[cell + 1] - first;
-    const float* shares = groupCdf_.data() + first;
-    // The first triangle whose cumulative share passes x (the last if none does), from where it would
-    // be if the areas were equal: a step or two on a tessellated lamp.
-    uint32_t k = std::min(uint32_t(x * float(count)), count - 1);
-    while (k > 0 && shares[k - 1] > x) --k;
-    while (k + 1 < count && shares[k] <= x) ++k;
-    const float before = k > 0 ? shares[k - 1] : 0.0f, share = shares[k] - before;
-    if (!(share > 0.0f)) return std::nullopt;
-    const size_t triangle = groupTriangles_[first + k];
-    const glm::vec2 square(std::clamp((x - before) / share, 0.0f, std::nextafter(1.0f, 0.0f)), u.y);
-    auto s = scene_->emitters().sampleTriangleByArea(p, triangle, square, width * areaShare_[triangle]);
-    if (s) s->guideSlot = slot;
-    return s;
-  }
-  const size_t triangle = cell / uint32_t(grid_ * grid_);
-  const uint32_t inTriangle = cell % uint32_t(grid_ * grid_);
-  const glm::vec2 square = (glm::vec2(float(inTriangle % uint32_t(grid_)), float(inTriangle / uint32_t(grid_))) +
-                            glm::vec2(x, u.y)) / float(grid_);
-  auto s = scene_->emitters().sampleTriangleByArea(p, triangle, square, width * float(grid_ * grid_));
+  TrianglePick t;
+  if (!trianglePoint(c, u.y, t)) return std::nullopt;
+  auto s = scene_->emitters().sampleTriangleByArea(p, t.triangle, t.square, t.choice);
   if (s) s->guideSlot = slot;
   return s;
 }

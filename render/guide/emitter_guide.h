@@ -121,6 +121,16 @@ class EmitterGuide {
     }
     region = (c[2] * regionsPerAxis_.y + c[1]) * regionsPerAxis_.x + c[0];
   }
+  // What sample() picks in a learned region whose cell u.x falls in is an emitting triangle's: the
+  // triangle, the point's square (sampleUniformTriangle's domain) and the probability that makes
+  // EmitterSet::sampleTriangleByArea's density, and the sample's guideSlot; false where the cell is a
+  // punctual light's or the sky's, or has no mass (the lanes sample the triangle's point in vector form).
+  struct TrianglePick {
+    uint32_t triangle = 0, slot = UINT32_MAX;
+    glm::vec2 square{0.0f};
+    float choice = 0.0f;
+  };
+  bool pickLearnedTriangle(uint32_t region, glm::vec2 u, TrianglePick& out) const;
   // The share of regions that sample from what they learned.
   float learnedRegionShare() const;
   int regions() const { return int(state_.size()); }
@@ -183,6 +193,15 @@ class EmitterGuide {
   float triangleChoice(uint32_t region, size_t triangle, uint32_t cell) const {
     return cellPmf(region, cell) * (grouped() ? areaShare_[triangle] : float(grid_ * grid_));
   }
+  // A learned region's cell for the number u, u rescaled within the cell, and the cell's probability
+  // (width 0: a cell without mass, which sends nothing).
+  struct CellPick {
+    uint32_t cell;
+    float x, width;
+  };
+  CellPick pickCell(uint32_t region, float u) const;
+  // The point of an emitting triangle's cell c, with v the point's second number.
+  bool trianglePoint(const CellPick& c, float v, TrianglePick& out) const;
   std::optional<LightSample> sampleLearned(const glm::vec3& p, uint32_t region, glm::vec2 u) const;
   Lane& lane() const;
 

@@ -31,60 +31,79 @@ __m256d lookUpDoubles(const double* table, int size, __m128i index) {
 
 // EmitterSet::sampleStratified from each lane's p with its numbers u, in lanes, where it folds the
 // choice and draws an untextured triangle by area, and the guide (if any) samples as EmitterSet
-// there: the same decisions in the same order, so the same sample up to float rounding. `served`:
-// the lanes whose sample this is (`found`: those that have one); the others (a triangle sampled by
-// solid angle, a punctual light or the sky, a region that learned, or one that records its samples
-// and has one to record) call the renderer's own code.
+// there: the same decisions in the same order, so the same sample up to float rounding. In a region
+// that learned, the guide picks the triangle and the point's square lane by lane, and the point is
+// drawn here as EmitterSet::sampleTriangleByArea draws it. `served`: the lanes whose sample this is
+// (`found`: those that have one); the others (a triangle sampled by solid angle, a punctual light or
+// the sky, or a region that records its samples and has one to record) call the renderer's own code.
 void PathLanes::Batch::sampleLights(F8 px, F8 py, F8 pz, F8 ux, F8 uy, LightLanes& out) const {
-  out.served = out.found = I8{};
+  out.served = out.found = out.learned = I8{};
+  out.slot.fill(UINT32_MAX);
   if (lanes_.lights_.empty()) return;
-  I8 served = alive_, recording{};
+  I8 served = alive_, recording{}, learned{}, region{};
   if (guide_) {
-    I8 region;
     guide_->regionIndex<F8, I8>(px, py, pz, [](const F8& t, I8& i) { i = __builtin_convertvector(t, I8); }, region);
     const EmitterGuide::State* states = guide_->states();
     for (int k = 0; k < kLanes; ++k) {
       const EmitterGuide::State state = states[region[k]];
-      if (state == EmitterGuide::State::Learned) served[k] = 0;
+      if (state == EmitterGuide::State::Learned) learned[k] = -1;
       if (state == EmitterGuide::State::Undecided) recording[k] = -1;
     }
-    if (!any(served)) return;
   }
 
-  // The folded choice (Distribution1D::sampleRange over every emitter), in doubles as there, four
-  // lanes at a time.
-  const double* cdf = lanes_.lightCdf_.data();
-  const int32_t n = int32_t(lanes_.lightCdf_.size() - 1);
-  const __m256d lo = _mm256_set1_pd(cdf[0]), span = _mm256_set1_pd(cdf[n] - cdf[0]);
-  const __m128i bits = _mm_setr_epi32(1, 2, 4, 8);
-  const auto maskOf = [&bits](__m256d m) {  // four doubles' compare mask as four ints' (0 or 1)
-    const __m128i b = _mm_and_si128(_mm_set1_epi32(_mm256_movemask_pd(m)), bits);
-    return _mm_srli_epi32(_mm_cmpeq_epi32(b, bits), 31);
-  };
-  alignas(32) int32_t chosen[kLanes];
-  alignas(32) float remappedU[kLanes];
-  for (int half = 0; half < 2; ++half) {
-    const __m128 u4 = half ? _mm256_extractf128_ps(__m256(ux), 1) : _mm256_castps256_ps128(__m256(ux));
-    const __m256d u = _mm256_min_pd(_mm256_max_pd(_mm256_cvtps_pd(u4), _mm256_setzero_pd()), _mm256_set1_pd(1.0));
-    const __m256d x = _mm256_add_pd(lo, _mm256_mul_pd(u, span));
-    __m128i base = _mm_set1_epi32(1);  // into cdf: the search runs over cdf[1, n]
-    for (int32_t m = n; m > 1;) {
-      const int32_t step = m / 2;
-      const __m128i probe = _mm_add_epi32(base, _mm_set1_epi32(step));
-      const __m256d below = _mm256_cmp_pd(lookUpDoubles(cdf, n + 1, probe), x, _CMP_LE_OQ);
-      base = _mm_add_epi32(base, _mm_mullo_epi32(maskOf(below), _mm_set1_epi32(step)));
-      m -= step;
+  // Without a folded choice (an emitter's power share too small to fold) the lanes serve only the
+  // regions that learned.
+  alignas(32) int32_t chosen[kLanes] = {};
+  alignas(32) float remappedU[kLanes] = {};
+  if (lanes_.lightCdf_.empty()) {
+    served &= learned;
+  } else {
+    // The folded choice (Distribution1D::sampleRange over every emitter), in doubles as there, four
+    // lanes at a time.
+    const double* cdf = lanes_.lightCdf_.data();
+    const int32_t n = int32_t(lanes_.lightCdf_.size() - 1);
+    const __m256d lo = _mm256_set1_pd(cdf[0]), span = _mm256_set1_pd(cdf[n] - cdf[0]);
+    const __m128i bits = _mm_setr_epi32(1, 2, 4, 8);
+    const auto maskOf = [&bits](__m256d m) {  // four doubles' compare mask as four ints' (0 or 1)
+      const __m128i b = _mm_and_si128(_mm_set1_epi32(_mm256_movemask_pd(m)), bits);
+      return _mm_srli_epi32(_mm_cmpeq_epi32(b, bits), 31);
+    };
+    for (int half = 0; half < 2; ++half) {
+      const __m128 u4 = half ? _mm256_extractf128_ps(__m256(ux), 1) : _mm256_castps256_ps128(__m256(ux));
+      const __m256d u = _mm256_min_pd(_mm256_max_pd(_mm256_cvtps_pd(u4), _mm256_setzero_pd()), _mm256_set1_pd(1.0));
+      const __m256d x = _mm256_add_pd(lo, _mm256_mul_pd(u, span));
+      __m128i base = _mm_set1_epi32(1);  // into cdf: the search runs over cdf[1, n]
+      for (int32_t m = n; m > 1;) {
+        const int32_t step = m / 2;
+        const __m128i probe = _mm_add_epi32(base, _mm_set1_epi32(step));
+        const __m256d below = _mm256_cmp_pd(lookUpDoubles(cdf, n + 1, probe), x, _CMP_LE_OQ);
+        base = _mm_add_epi32(base, _mm_mullo_epi32(maskOf(below), _mm_set1_epi32(step)));
+        m -= step;
+      }
+      const __m256d last = _mm256_cmp_pd(lookUpDoubles(cdf, n + 1, base), x, _CMP_LE_OQ);
+      __m128i index = _mm_add_epi32(_mm_sub_epi32(base, _mm_set1_epi32(1)), maskOf(last));
+      index = _mm_min_epi32(index, _mm_set1_epi32(n - 1));  // below == n: the last
+      const __m256d low = lookUpDoubles(cdf, n + 1, index);
+      const __m256d width = _mm256_sub_pd(lookUpDoubles(cdf, n + 1, _mm_add_epi32(index, _mm_set1_epi32(1))), low);
+      __m256d r = _mm256_and_pd(_mm256_div_pd(_mm256_sub_pd(x, low), width),
+                                _mm256_cmp_pd(width, _mm256_setzero_pd(), _CMP_GT_OQ));
+      r = _mm256_min_pd(_mm256_max_pd(r, _mm256_setzero_pd()), _mm256_set1_pd(double(0x1.fffffep-1f)));
+      _mm_store_si128(reinterpret_cast<__m128i*>(chosen + 4 * half), index);
+      _mm_store_ps(remappedU + 4 * half, _mm256_cvtpd_ps(r));
     }
-    const __m256d last = _mm256_cmp_pd(lookUpDoubles(cdf, n + 1, base), x, _CMP_LE_OQ);
-    __m128i index = _mm_add_epi32(_mm_sub_epi32(base, _mm_set1_epi32(1)), maskOf(last));
-    index = _mm_min_epi32(index, _mm_set1_epi32(n - 1));  // below == n: the last
-    const __m256d low = lookUpDoubles(cdf, n + 1, index);
-    const __m256d width = _mm256_sub_pd(lookUpDoubles(cdf, n + 1, _mm_add_epi32(index, _mm_set1_epi32(1))), low);
-    __m256d r = _mm256_and_pd(_mm256_div_pd(_mm256_sub_pd(x, low), width),
-                              _mm256_cmp_pd(width, _mm256_setzero_pd(), _CMP_GT_OQ));
-    r = _mm256_min_pd(_mm256_max_pd(r, _mm256_setzero_pd()), _mm256_set1_pd(double(0x1.fffffep-1f)));
-    _mm_store_si128(reinterpret_cast<__m128i*>(chosen + 4 * half), index);
-    _mm_store_ps(remappedU + 4 * half, _mm256_cvtpd_ps(r));
+  }
+  // A learned region's own choice: the triangle, the point's square, the choice's probability.
+  F8 v = uy, choice{};
+  learned &= served;
+  for (int k = 0; k < kLanes; ++k) {
+    if (!learned[k]) continue;
+    EmitterGuide::TrianglePick pick;
+    if (!guide_->pickLearnedTriangle(uint32_t(region[k]), glm::vec2(ux[k], uy[k]), pick)) {
+      served[k] = learned[k] = 0;
+      continue;
+    }
+    chosen[k] = int32_t(pick.triangle), remappedU[k] = pick.square.x, v[k] = pick.square.y, choice[k] = pick.choice;
+    out.slot[k] = pick.slot;
   }
   const I8 index = *reinterpret_cast<const I8*>(chosen);
   const F8 u0 = *reinterpret_cast<const F8*>(remappedU);
@@ -102,7 +121,7 @@ void PathLanes::Batch::sampleLights(F8 px, F8 py, F8 pz, F8 ux, F8 uy, LightLane
     for (int i = 1; i < lights; ++i) v = light == i ? splat((&f)[i * stride]) : v;
     return v;
   };
-  served &= field(r0.foldedPmf) > 0.0f;
+  served &= learned | (field(r0.foldedPmf) > 0.0f);
   const F8 ax = field(r0.p0[0]), ay = field(r0.p0[1]), az = field(r0.p0[2]);
   const F8 lnx = field(r0.normal[0]), lny = field(r0.normal[1]), lnz = field(r0.normal[2]);
   const I8 twoSided = field(r0.twoSided) > 0.0f;
@@ -111,18 +130,19 @@ void PathLanes::Batch::sampleLights(F8 px, F8 py, F8 pz, F8 ux, F8 uy, LightLane
   const F8 h = lnx * (px - ax) + lny * (py - ay) + lnz * (pz - az);
   const F8 extent = max8(field(r0.coordinateScale), max8(abs8(px), max8(abs8(py), abs8(pz))));
   I8 found = served & (abs8(h) > EmitterSet::kPlaneTolerance * extent) & ((h > 0.0f) | twoSided);
-  // EmitterSet::solidAngleStrategy's test: a triangle that looks large goes to the scalar code.
+  // EmitterSet::solidAngleStrategy's test: a triangle that looks large goes to the scalar code (a
+  // learned region samples by area whatever the triangle looks like).
   const F8 cx = field(r0.centre[0]) - px, cy = field(r0.centre[1]) - py, cz = field(r0.centre[2]) - pz;
   const F8 hp = abs8(lnx * (ax - px) + lny * (ay - py) + lnz * (az - pz));
   const F8 nearest = max8(hp, sqrt8(cx * cx + cy * cy + cz * cz) - field(r0.radius));
-  served &= ~(found & (field(r0.longestEdge) > EmitterSet::kSolidAngleSpread * nearest));
+  served &= ~(found & ~learned & (field(r0.longestEdge) > EmitterSet::kSolidAngleSpread * nearest));
   found &= served;
   out.served = served;
   if (!any(found)) return;
 
   // EmitterSet::sampleTrianglePoint: sampleUniformTriangle's point, then its direction and density.
-  const I8 below0 = u0 < uy;
-  const F8 b0 = below0 ? u0 / 2.0f : u0 - uy / 2.0f, b1 = below0 ? uy - u0 / 2.0f : uy / 2.0f;
+  const I8 below0 = u0 < v;
+  const F8 b0 = below0 ? u0 / 2.0f : u0 - v / 2.0f, b1 = below0 ? v - u0 / 2.0f : v / 2.0f;
   const F8 bx = b1, by = 1.0f - b0 - b1, bw = 1.0f - bx - by;
   const F8 dx = ax * bw + field(r0.p1[0]) * bx + field(r0.p2[0]) * by - px;
   const F8 dy = ay * bw + field(r0.p1[1]) * bx + field(r0.p2[1]) * by - py;
@@ -136,7 +156,7 @@ void PathLanes::Batch::sampleLights(F8 px, F8 py, F8 pz, F8 ux, F8 uy, LightLane
   out.r = field(r0.emission[0]), out.g = field(r0.emission[1]), out.b = field(r0.emission[2]);
   found &= (out.r > 0.0f) | (out.g > 0.0f) | (out.b > 0.0f);
   out.cosLight = abs8(cosLight);
-  out.pdf = field(r0.pmf) * dist2 / (out.cosLight * field(r0.area));
+  out.pdf = (learned ? choice : field(r0.pmf)) * dist2 / (out.cosLight * field(r0.area));
   // EmitterSet::emissionPdf, for bidirectional MIS's weight.
   if (connections_)
     out.emissionPdf = field(r0.pmf) * out.cosLight / (std::numbers::pi_v<float> * field(r0.area) * (twoSided ? splat(2.0f) : splat(1.0f)));
@@ -144,6 +164,7 @@ void PathLanes::Batch::sampleLights(F8 px, F8 py, F8 pz, F8 ux, F8 uy, LightLane
   // no sample there is nothing to record (a ceiling behind a one-sided light: most of such regions).
   out.served = served & ~(found & recording);
   out.found = found & out.served;
+  out.learned = learned & out.found;
 }
 
 }  // namespace vpl

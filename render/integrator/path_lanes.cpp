@@ -51,7 +51,7 @@ PathLanes::PathLanes(const PathTracer& tracer) : tracer_(tracer), scene_(tracer.
     }
   }
   const EmitterSet& emitters = scene_.emitters();
-  if (!emitters.foldsChoice()) return;
+  const bool folds = emitters.foldsChoice();
   for (size_t i = 0; i < emitters.triangleCount(); ++i) {
     const EmitterSet::TriangleLight& t = emitters.triangleLight(i);
     if (t.textured) {
@@ -62,8 +62,9 @@ PathLanes::PathLanes(const PathTracer& tracer) : tracer_(tracer), scene_(tracer.
     lights_.push_back({{t.p0.x, t.p0.y, t.p0.z}, {t.p1.x, t.p1.y, t.p1.z}, {t.p2.x, t.p2.y, t.p2.z},
                        {t.normal.x, t.normal.y, t.normal.z}, {t.centre.x, t.centre.y, t.centre.z}, t.radius,
                        t.longestEdge, t.coordinateScale, t.area, t.twoSided ? 1.0f : 0.0f, {le.x, le.y, le.z},
-                       emitters.emitterPmf(i), emitters.foldedChoice().pmf(i)});
+                       emitters.emitterPmf(i), folds ? emitters.foldedChoice().pmf(i) : 0.0f});
   }
+  if (!folds) return;
   const Distribution1D& choice = emitters.foldedChoice();
   for (size_t i = 0; i <= choice.size(); ++i) lightCdf_.push_back(choice.cdf(i));
 }
@@ -382,7 +383,8 @@ void PathLanes::Batch::bounce() {
     const F8 wx = lights.wx, wy = lights.wy, wz = lights.wz;
     const F8 cosIn = wx * sx + wy * sy + wz * sz, cosOutgoing = -(dx_ * sx + dy_ * sy + dz_ * sz);
     const F8 fr = ar * kInvPiF * cosIn, fg = ag * kInvPiF * cosIn, fb = ab * kInvPiF * cosIn;
-    const I8 lit = lights.found & (wx * nx + wy * ny + wz * nz > 0.0f) & (cosOutgoing > 0.0f) & (cosIn > 0.0f) &
+    const F8 cosReceiver = wx * nx + wy * ny + wz * nz;
+    const I8 lit = lights.found & (cosReceiver > 0.0f) & (cosOutgoing > 0.0f) & (cosIn > 0.0f) &
                    ((fr > 0.0f) | (fg > 0.0f) | (fb > 0.0f));
     F8 sdx, sdy, sdz, tMax;
     aimShadowRay(px, py, pz, qx, qy, qz, wx, wy, wz, lights.distance, sdx, sdy, sdz, tMax,
@@ -406,8 +408,13 @@ void PathLanes::Batch::bounce() {
       shadow.org_x[k] = qx[k], shadow.org_y[k] = qy[k], shadow.org_z[k] = qz[k];
       shadow.dir_x[k] = sdx[k], shadow.dir_y[k] = sdy[k], shadow.dir_z[k] = sdz[k];
       shadow.tfar[k] = tMax[k];
-      contribution[k] = glm::vec3(fr[k], fg[k], fb[k]) * glm::vec3(lights.r[k], lights.g[k], lights.b[k]) * share[k];
-      slot[k] = UINT32_MAX;
+      const glm::vec3 emitted(lights.r[k], lights.g[k], lights.b[k]);
+      contribution[k] = glm::vec3(fr[k], fg[k], fb[k]) * emitted * share[k];
+      slot[k] = lights.slot[k];  // a learned region's: its sample's arrival is recorded
+      if (lights.learned[k]) {
+        guide_->attempted(slot[k]);
+        arrival[k] = luminance(emitted) * cosReceiver[k] / lights.pdf[k];
+      }
       tested[k] = -1;
     }
   }

@@ -74,9 +74,9 @@ class PathLanes {
   std::vector<uint8_t> emits_;  // the triangle is one of EmitterSet's lights
   std::vector<uint32_t> smooth_;  // where the triangle's three vertex normals start in normals_; UINT32_MAX: none
   std::vector<glm::vec3> normals_;
-  // Empty where the lanes leave next-event estimation to EmitterSet lane by lane (the choice is not
-  // folded, or an emitter is textured); else one record per emitting triangle, and the folded choice's
-  // CDF (Distribution1D::cdf).
+  // Empty where the lanes leave next-event estimation to EmitterSet lane by lane (an emitter is
+  // textured); else one record per emitting triangle, and, where EmitterSet folds its choice, the folded
+  // choice's CDF (Distribution1D::cdf; without it only the regions that learned sample in lanes).
   std::vector<LightRecord> lights_;
   std::vector<double> lightCdf_;
 };

@@ -4,6 +4,7 @@
 // to them: everything here is compiled for AVX2 and FMA alone, which PathLanes::unsupported() checks.
 #pragma once
 #include <immintrin.h>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <optional>
@@ -86,8 +87,9 @@ class PathLanes::Batch {
   };
   // Next-event estimation's light samples of the eight lanes, and which lanes have one (sampleLights()).
   struct LightLanes {
-    I8 served, found;
+    I8 served, found, learned;  // learned: found in a region that learned, whose sample records its arrival
     F8 wx, wy, wz, distance, r, g, b, pdf, cosLight, emissionPdf;
+    std::array<uint32_t, kLanes> slot;  // learned lanes' EmitterGuide slots
   };
 
   // The vertex that joins, in lanes: bounce()'s hit, its normals (geometric, shading), its albedo, and

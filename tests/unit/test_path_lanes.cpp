@@ -146,8 +146,9 @@ SceneData panelLeafStripRoom() {
 // by area, the shadow ray's margin, the MIS weight) against EmitterSet's, on lights the Cornell box
 // lacks: several triangles of different sizes and colours, a two-sided one seen from both sides, a
 // one-sided panel that the floor behind it sees from the back, and points close enough to a light
-// that it is sampled by solid angle (left to EmitterSet). With the learned light sampling too, whose
-// plain regions the lanes serve.
+// that it is sampled by solid angle (left to EmitterSet). With the learned light sampling too: its
+// plain regions the lanes serve as EmitterSet, its learned ones from the guide's pick of triangle and
+// square; and with joins, whose MIS weights take the learned density.
 TEST(PathLanes, LightsSampledInLanesAsEmitterSet) {
   if (!cpuHasLanes()) GTEST_SKIP() << "this CPU has no AVX2 and FMA: the lanes never run";
   const SceneData scene = panelLeafStripRoom();
@@ -158,19 +159,23 @@ TEST(PathLanes, LightsSampledInLanesAsEmitterSet) {
   s.scenePath = "panel, leaf and strip";
   s.tracer.roulette = RouletteRule::Sqrt;
   for (const SceneData* lit : {&scene, static_cast<const SceneData*>(&fewer)})
-    for (const bool learn : {false, true}) {
-      SCOPED_TRACE(std::string(lit == &scene ? "five" : "three") + " emitting triangles, " +
-                   (learn ? "learned light sampling" : "no learning"));
-      s.tracer.learnLights = learn;
-      const auto [lanes, scalar] = withAndWithout(s, lit);
-      EXPECT_GT(meanRgb(scalar.image).x, 0.05);
-      EXPECT_LT(relMse(lanes.image, scalar.image), 1e-8);
-      EXPECT_NEAR(double(lanes.rays), double(scalar.rays), 1e-4 * double(scalar.rays));
-      if (learn) {  // some regions behind the low wall learned, the same ones with and without lanes
-        EXPECT_GT(scalar.learnedLightRegions, 0.0);
-        EXPECT_EQ(lanes.learnedLightRegions, scalar.learnedLightRegions);
+    for (const bool learn : {false, true})
+      for (const bool joins : {false, true}) {
+        if (joins && !learn) continue;  // JoinsAsRadiance has those
+        SCOPED_TRACE(std::string(lit == &scene ? "five" : "three") + " emitting triangles, " +
+                     (learn ? "learned light sampling" : "no learning") + (joins ? ", with joins (their MIS weights)" : ""));
+        s.tracer.learnLights = learn;
+        s.connections.paths = joins ? 512 : 0;
+        s.connections.learnChoice = false;
+        const auto [lanes, scalar] = withAndWithout(s, lit);
+        EXPECT_GT(meanRgb(scalar.image).x, 0.05);
+        EXPECT_LT(relMse(lanes.image, scalar.image), 1e-8);
+        EXPECT_NEAR(double(lanes.rays), double(scalar.rays), 1e-4 * double(scalar.rays));
+        if (learn) {  // some regions behind the low wall learned, the same ones with and without lanes
+          EXPECT_GT(scalar.learnedLightRegions, 0.0);
+          EXPECT_EQ(lanes.learnedLightRegions, scalar.learnedLightRegions);
+        }
       }
-    }
 }
 
 // The VPL weight window: roulette by the VPLs' estimate, and splits whose branches a lane traces after
