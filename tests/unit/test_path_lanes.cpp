@@ -166,6 +166,7 @@ TEST(PathLanes, LightsSampledInLanesAsEmitterSet) {
                      (learn ? "learned light sampling" : "no learning") + (joins ? ", with joins (their MIS weights)" : ""));
         s.tracer.learnLights = learn;
         s.connections.paths = joins ? 512 : 0;
+        s.spp = joins ? 96 : 32;  // with joins, enough passes after the regions learned to weigh their samples
         s.connections.learnChoice = false;
         const auto [lanes, scalar] = withAndWithout(s, lit);
         EXPECT_GT(meanRgb(scalar.image).x, 0.05);
