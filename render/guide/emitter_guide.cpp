@@ -227,7 +227,7 @@ EmitterGuide::CellPick EmitterGuide::pickCell(uint32_t region, float u) const {
   return {cell, std::clamp((u - low) / width, 0.0f, std::nextafter(1.0f, 0.0f)), width};
 }
 
-bool EmitterGuide::trianglePoint(const CellPick& c, float v, TrianglePick& out) const {
+bool EmitterGuide::cellPoint(const CellPick& c, float v, TrianglePick& out) const {
   if (grouped()) {
     // A triangle of the group by its share of the group's area (x rescaled once more), then its point.
     const uint32_t first = groupFirst_[c.cell], count = groupFirst_[c.cell + 1] - first;
@@ -256,7 +256,7 @@ bool EmitterGuide::pickLearnedTriangle(uint32_t region, glm::vec2 u, TrianglePic
   const CellPick c = pickCell(region, u.x);
   if (!(c.width > 0.0f) || c.cell >= uint32_t(punctualFirst_)) return false;
   out.slot = region * uint32_t(cells_) + c.cell;
-  return trianglePoint(c, u.y, out);
+  return cellPoint(c, u.y, out);
 }
 
 std::optional<LightSample> EmitterGuide::sampleLearned(const glm::vec3& p, uint32_t region, glm::vec2 u) const {
@@ -283,7 +283,7 @@ std::optional<LightSample> EmitterGuide::sampleLearned(const glm::vec3& p, uint3
     return s;
   }
   TrianglePick t;
-  if (!trianglePoint(c, u.y, t)) return std::nullopt;
+  if (!cellPoint(c, u.y, t)) return std::nullopt;
   auto s = scene_->emitters().sampleTriangleByArea(p, t.triangle, t.square, t.choice);
   if (s) s->guideSlot = slot;
   return s;

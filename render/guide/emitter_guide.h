@@ -121,10 +121,10 @@ class EmitterGuide {
     }
     region = (c[2] * regionsPerAxis_.y + c[1]) * regionsPerAxis_.x + c[0];
   }
-  // What sample() picks in a learned region whose cell u.x falls in is an emitting triangle's: the
-  // triangle, the point's square (sampleUniformTriangle's domain) and the probability that makes
-  // EmitterSet::sampleTriangleByArea's density, and the sample's guideSlot; false where the cell is a
-  // punctual light's or the sky's, or has no mass (the lanes sample the triangle's point in vector form).
+  // sample()'s pick in learned region `region` from the numbers u, where u.x falls in a cell of an
+  // emitting triangle: the triangle, the point's square (sampleUniformTriangle's domain), the
+  // probability that makes EmitterSet::sampleTriangleByArea's density, and the sample's guideSlot. False
+  // where the cell is a punctual light's or the sky's, or has no mass. (The lanes draw the point.)
   struct TrianglePick {
     uint32_t triangle = 0, slot = UINT32_MAX;
     glm::vec2 square{0.0f};
@@ -200,8 +200,8 @@ class EmitterGuide {
     float x, width;
   };
   CellPick pickCell(uint32_t region, float u) const;
-  // The point of an emitting triangle's cell c, with v the point's second number.
-  bool trianglePoint(const CellPick& c, float v, TrianglePick& out) const;
+  // The triangle and square of a point of emitting triangle cell c, with v the point's second number.
+  bool cellPoint(const CellPick& c, float v, TrianglePick& out) const;
   std::optional<LightSample> sampleLearned(const glm::vec3& p, uint32_t region, glm::vec2 u) const;
   Lane& lane() const;
 

@@ -93,7 +93,7 @@ void PathLanes::Batch::sampleLights(F8 px, F8 py, F8 pz, F8 ux, F8 uy, LightLane
     }
   }
   // A learned region's own choice: the triangle, the point's square, the choice's probability.
-  F8 v = uy, choice{};
+  F8 u1 = uy, choice{};
   learned &= served;
   for (int k = 0; k < kLanes; ++k) {
     if (!learned[k]) continue;
@@ -102,7 +102,7 @@ void PathLanes::Batch::sampleLights(F8 px, F8 py, F8 pz, F8 ux, F8 uy, LightLane
       served[k] = learned[k] = 0;
       continue;
     }
-    chosen[k] = int32_t(pick.triangle), remappedU[k] = pick.square.x, v[k] = pick.square.y, choice[k] = pick.choice;
+    chosen[k] = int32_t(pick.triangle), remappedU[k] = pick.square.x, u1[k] = pick.square.y, choice[k] = pick.choice;
     out.slot[k] = pick.slot;
   }
   const I8 index = *reinterpret_cast<const I8*>(chosen);
@@ -141,8 +141,8 @@ void PathLanes::Batch::sampleLights(F8 px, F8 py, F8 pz, F8 ux, F8 uy, LightLane
   if (!any(found)) return;
 
   // EmitterSet::sampleTrianglePoint: sampleUniformTriangle's point, then its direction and density.
-  const I8 below0 = u0 < v;
-  const F8 b0 = below0 ? u0 / 2.0f : u0 - v / 2.0f, b1 = below0 ? v - u0 / 2.0f : v / 2.0f;
+  const I8 below0 = u0 < u1;
+  const F8 b0 = below0 ? u0 / 2.0f : u0 - u1 / 2.0f, b1 = below0 ? u1 - u0 / 2.0f : u1 / 2.0f;
   const F8 bx = b1, by = 1.0f - b0 - b1, bw = 1.0f - bx - by;
   const F8 dx = ax * bw + field(r0.p1[0]) * bx + field(r0.p2[0]) * by - px;
   const F8 dy = ay * bw + field(r0.p1[1]) * bx + field(r0.p2[1]) * by - py;
