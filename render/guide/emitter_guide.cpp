@@ -223,8 +223,9 @@ EmitterGuide::CellPick EmitterGuide::pickCell(uint32_t region, float u) const {
   uint32_t cell = table.cuts[size_t(std::min(int(u * float(kCuts)), kCuts - 1))];
   while (cell + 1 < uint32_t(cells_) && cdf[cell] <= u) ++cell;
   const float low = cell > 0 ? cdf[cell - 1] : 0.0f, width = cdf[cell] - low;
-  if (!(width > 0.0f)) return {cell, 0.0f, 0.0f};
-  return {cell, std::clamp((u - low) / width, 0.0f, std::nextafter(1.0f, 0.0f)), width};
+  const uint32_t slot = region * uint32_t(cells_) + cell;
+  if (!(width > 0.0f)) return {cell, slot, 0.0f, 0.0f};
+  return {cell, slot, std::clamp((u - low) / width, 0.0f, std::nextafter(1.0f, 0.0f)), width};
 }
 
 bool EmitterGuide::cellPoint(const CellPick& c, float v, TrianglePick& out) const {
@@ -255,14 +256,13 @@ bool EmitterGuide::cellPoint(const CellPick& c, float v, TrianglePick& out) cons
 bool EmitterGuide::pickLearnedTriangle(uint32_t region, glm::vec2 u, TrianglePick& out) const {
   const CellPick c = pickCell(region, u.x);
   if (!(c.width > 0.0f) || c.cell >= uint32_t(punctualFirst_)) return false;
-  out.slot = region * uint32_t(cells_) + c.cell;
+  out.slot = c.slot;
   return cellPoint(c, u.y, out);
 }
 
 std::optional<LightSample> EmitterGuide::sampleLearned(const glm::vec3& p, uint32_t region, glm::vec2 u) const {
   const CellPick c = pickCell(region, u.x);
   if (!(c.width > 0.0f)) return std::nullopt;
-  const uint32_t slot = region * uint32_t(cells_) + c.cell;
   if (c.cell >= uint32_t(skyFirst_)) {
     // A direction uniform in the sky cell's solid angle (the map preserves area).
     const uint32_t bin = c.cell - uint32_t(skyFirst_);
@@ -273,19 +273,19 @@ std::optional<LightSample> EmitterGuide::sampleLearned(const glm::vec3& p, uint3
     s.radiance = scene_->emitters().sky();
     s.pdf = c.width * float(kSkyResolution * kSkyResolution) / (4.0f * kPi);
     s.emitter = scene_->emitters().skyIndex();
-    s.guideSlot = slot;
+    s.guideSlot = c.slot;
     return s;
   }
   if (c.cell >= uint32_t(punctualFirst_)) {
     const EmitterSet& emitters = scene_->emitters();
     auto s = emitters.samplePunctual(p, emitters.triangleCount() + (c.cell - uint32_t(punctualFirst_)), c.width);
-    if (s) s->guideSlot = slot;
+    if (s) s->guideSlot = c.slot;
     return s;
   }
   TrianglePick t;
   if (!cellPoint(c, u.y, t)) return std::nullopt;
   auto s = scene_->emitters().sampleTriangleByArea(p, t.triangle, t.square, t.choice);
-  if (s) s->guideSlot = slot;
+  if (s) s->guideSlot = c.slot;
   return s;
 }
 

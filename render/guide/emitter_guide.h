@@ -193,10 +193,10 @@ class EmitterGuide {
   float triangleChoice(uint32_t region, size_t triangle, uint32_t cell) const {
     return cellPmf(region, cell) * (grouped() ? areaShare_[triangle] : float(grid_ * grid_));
   }
-  // A learned region's cell for the number u, u rescaled within the cell, and the cell's probability
-  // (width 0: a cell without mass, which sends nothing).
+  // A learned region's cell for the number u, its slot (region and cell), u rescaled within the cell,
+  // and the cell's probability (width 0: a cell without mass, which sends nothing).
   struct CellPick {
-    uint32_t cell;
+    uint32_t cell, slot;
     float x, width;
   };
   CellPick pickCell(uint32_t region, float u) const;

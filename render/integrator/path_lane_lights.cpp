@@ -52,12 +52,12 @@ void PathLanes::Batch::sampleLights(F8 px, F8 py, F8 pz, F8 ux, F8 uy, LightLane
   }
 
   // Without a folded choice (an emitter's power share too small to fold) the lanes serve only the
-  // regions that learned.
+  // regions that learned; where every lane's region learned, the folded choice is not needed either.
   alignas(32) int32_t chosen[kLanes] = {};
   alignas(32) float remappedU[kLanes] = {};
   if (lanes_.lightCdf_.empty()) {
     served &= learned;
-  } else {
+  } else if (any(served & ~learned)) {
     // The folded choice (Distribution1D::sampleRange over every emitter), in doubles as there, four
     // lanes at a time.
     const double* cdf = lanes_.lightCdf_.data();
