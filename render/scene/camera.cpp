@@ -37,6 +37,18 @@ CameraData frameBounds(const glm::vec3& boundsMin, const glm::vec3& boundsMax, f
   c.target = centre;
   c.eye = centre + glm::vec3(0, 0, distance);
   c.up = glm::vec3(0, 1, 0);
+  // A flat scene seen edge on would be a line on a blank image (a ground plane along -Z): look along
+  // its thinnest axis instead, from above for a horizontal one (-Z up, as a plan is drawn).
+  const glm::vec3 extent = boundsMax - boundsMin;
+  const float largest = std::max({extent.x, extent.y, extent.z});
+  if (std::min(extent.x, extent.y) < 0.01f * largest) {
+    if (extent.y <= extent.x) {
+      c.eye = centre + glm::vec3(0, distance, 0);
+      c.up = glm::vec3(0, 0, -1);
+    } else {
+      c.eye = centre + glm::vec3(distance, 0, 0);
+    }
+  }
   c.yfov = yfov;
   return c;
 }

@@ -41,7 +41,8 @@ class Camera {
 };
 
 // A camera that sees the whole scene: looking at the bounds' centre along -Z from outside the
-// bounding sphere (the usual viewer default when a file has no camera).
+// bounding sphere (the usual viewer default when a file has no camera), or along the thinnest axis
+// where the scene is flat and -Z would see it edge on.
 CameraData frameBounds(const glm::vec3& boundsMin, const glm::vec3& boundsMax, float yfov = 0.7f);
 
 // The file's camera if it has one, else frameBounds.
