@@ -125,8 +125,8 @@ int runRender(const RenderOptions& options) {
   const RenderJobSettings settings = options.toSettings();
   tbb::global_control threads(tbb::global_control::max_allowed_parallelism, options.threadCount());
   // Check the outputs before spending minutes on a render that cannot be saved.
-  checkWritable(options.out);
-  if (!options.png.empty()) checkWritable(options.png);
+  checkWritable(options.out, "exr");
+  if (!options.png.empty()) checkWritable(options.png, "png");
   const RenderJobResult result = renderWithProgress(settings, "render");
 
   writeExr(options.out, result.image);
@@ -154,7 +154,7 @@ int runBench() {
 int runCapture() {
   RenderJobSettings settings = gCapture.toSettings();
   tbb::global_control threads(tbb::global_control::max_allowed_parallelism, gCapture.threadCount());
-  checkWritable(gCapture.out);
+  checkWritable(gCapture.out, "png");
   const RenderJobResult result = renderWithProgress(settings, "capture");
   // Through the viewer's own display code, in a software OpenGL context.
   writePngBytes(gCapture.out, result.image.width, result.image.height,
@@ -185,7 +185,7 @@ int runViewerCommand() {
   options.screenshotAfter = gScreenshotAfter;
   options.statsLog = gStatsLog;
   options.screenshotPanel = gScreenshotPanel;
-  if (!gScreenshot.empty()) checkWritable(gScreenshot);
+  if (!gScreenshot.empty()) checkWritable(gScreenshot, "png");
   return ui::runViewer(options);
 }
 
@@ -197,7 +197,7 @@ int runCompare() {
   j["relmse"] = relMse(image, reference);
   j["bias"] = relativeBias(image, reference);
   if (!gCompareMap.empty()) {
-    checkWritable(gCompareMap);
+    checkWritable(gCompareMap, "png");
     writePng(gCompareMap, falseColourLog(relMseMap(image, reference)));
     j["error_map"] = gCompareMap;
   }

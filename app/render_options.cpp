@@ -1,5 +1,7 @@
 #include "app/render_options.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -219,8 +221,16 @@ int RenderOptions::threadCount() const {
   return threads > 0 ? threads : int(std::max(1u, std::thread::hardware_concurrency()));
 }
 
-void checkWritable(const std::string& path) {
+void checkWritable(const std::string& path, const char* format) {
   const std::filesystem::path p(path);
+  if (format) {
+    std::string ext = p.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    for (const char* image : {".exr", ".png", ".jpg", ".jpeg", ".hdr", ".tif", ".tiff", ".bmp", ".ppm"})
+      if (ext == image && ext != std::string(".") + format)
+        throw InputError(path + ": this file is written as " + (std::string(format) == "exr" ? "OpenEXR" : "PNG") +
+                         ", not " + ext.substr(1) + ": name it ." + format);
+  }
   const std::filesystem::path dir = p.has_parent_path() ? p.parent_path() : std::filesystem::path(".");
   std::error_code ec;
   if (!std::filesystem::is_directory(dir, ec)) throw InputError(path + ": folder " + dir.string() + " does not exist");

@@ -46,7 +46,9 @@ struct RenderOptions {
 // two_rooms and the interior.
 inline constexpr int kGuidedSliceSize = 512;
 
-// Throws InputError when a file cannot be created at path (missing folder, no permission).
-void checkWritable(const std::string& path);
+// Throws InputError when a file cannot be created at path (missing folder, no permission), or when
+// its name says another image format than the one written there (`format`: "exr" or "png"; a name
+// with no image extension is the user's choice).
+void checkWritable(const std::string& path, const char* format = nullptr);
 
 }  // namespace vpl::app

@@ -4,7 +4,8 @@
 # past it write() fails, and SIGXFSZ must not kill vplview). The second run must exit 2 with one line
 # on stderr, leave the first files byte for byte and leave no temporary. Then: a target that is a
 # folder, and a folder vplview may not write in (as user nobody when run as root: chmod does not
-# stop root). Usage (CTest): atomic_writes.sh PATH/TO/vplview REPO_ROOT.
+# stop root), and names that say another image format than the one written. Usage (CTest):
+# atomic_writes.sh PATH/TO/vplview REPO_ROOT.
 set -u
 exe=$1; repo=$2
 scene=$repo/scenes/cornell_box.gltf
@@ -72,6 +73,20 @@ if command -v xvfb-run > /dev/null; then
 else
   echo "note: xvfb-run is missing: the viewer's --screenshot was not checked"
 fi
+
+# A name that says another format than the one written: refused before rendering, nothing written.
+wrong_name() {
+  local name=$1 target=$2; shift 2
+  "$@" > /dev/null 2> "$tmp/err"; local rc=$?
+  [ $rc = 2 ] && [ "$(grep -c . "$tmp/err")" = 1 ] && grep -q "name it" "$tmp/err" && [ ! -e "$target" ] ||
+    fail "$name: exit $rc: $(cat "$tmp/err")"
+  echo "ok: $name: $(cat "$tmp/err")"
+}
+wrong_name "render --out x.png" "$tmp/x.png" "$exe" render "$scene" --mode brdf "${small[@]}" --out "$tmp/x.png"
+wrong_name "render --png x.exr" "$tmp/x.exr" "$exe" render "$scene" --mode brdf "${small[@]}" --out "$tmp/y.exr" --png "$tmp/x.exr"
+wrong_name "capture --out x.EXR" "$tmp/x.EXR" "$exe" capture "$scene" --mode brdf "${small[@]}" --out "$tmp/x.EXR"
+"$exe" render "$scene" --mode brdf "${small[@]}" --out "$tmp/upper.EXR" --png "$tmp/upper.PNG" > /dev/null 2> "$tmp/err" &&
+  [ -s "$tmp/upper.EXR" ] && [ -s "$tmp/upper.PNG" ] || fail "render --out upper.EXR --png upper.PNG: $(cat "$tmp/err")"
 
 # A target that is a folder.
 mkdir "$tmp/folder.exr"
