@@ -13,11 +13,11 @@ MetropolisChain::MetropolisChain(const GuideDistribution& distribution, const gl
     : state_(glm::normalize(start)), statePdf_(distribution.pdf(state_)) {}
 
 glm::vec3 MetropolisChain::next(const GuideDistribution& distribution, const GuideSettings& settings, Rng& rng,
-                                ChainStats& stats) {
+                                ChainStats& stats, const glm::vec2* firstPoint) {
   const Cone perturb = Cone::fromAngle(settings.perturbationAngle);
   for (int m = 0; m < settings.mutations; ++m) {
     const float uKind = rng.uniform();
-    const glm::vec2 u = rng.uniform2();
+    const glm::vec2 u = m == 0 && firstPoint ? *firstPoint : rng.uniform2();
     // Both proposals are symmetric (q(x -> y) = q(y -> x)), so the acceptance is the pdf ratio.
     const glm::vec3 proposal = uKind < settings.uniformMutation
                                    ? sampleUniformSphere(u)

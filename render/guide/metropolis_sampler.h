@@ -24,8 +24,12 @@ class MetropolisChain {
   // forgets its start.
   MetropolisChain(const GuideDistribution& distribution, const glm::vec3& start);
 
-  // Runs `settings.mutations` steps and returns the new state.
-  glm::vec3 next(const GuideDistribution& distribution, const GuideSettings& settings, Rng& rng, ChainStats& stats);
+  // Runs `settings.mutations` steps and returns the new state. `firstPoint`, when given, is the first
+  // step's proposal point in place of two numbers of rng: a pixel's stratified pair, as the other
+  // strategies' directions take it. Each pixel scrambles its own, so to the chain it is one more
+  // uniform pair independent of its state, and the steps keep the guide's pdf.
+  glm::vec3 next(const GuideDistribution& distribution, const GuideSettings& settings, Rng& rng, ChainStats& stats,
+                 const glm::vec2* firstPoint = nullptr);
 
   glm::vec3 state() const { return state_; }
 

@@ -70,13 +70,16 @@ bool GuidedContinuation::sample(const SurfaceHit& hit, const Bsdf& bsdf, const g
     } else if (mode_ == SamplingMode::Mixture || revisit) {
       out.wi = guide.sample(u.guideCell(), u.guidePoint());
     } else {
-      // A Markov chain's states are not stratified samples: its start and mutations use the
-      // vertex's random stream.
+      // A Markov chain's states are not stratified samples, but its proposals can be: the first
+      // step proposes from the vertex's stratified pair (the rest of it past the BSDF's share), its
+      // start, its kind of step and its acceptance use the vertex's random stream.
       chainsUsedByPath_.push_back(c);
       auto it = chains_.find(c);
       if (it == chains_.end()) it = chains_.emplace(c, MetropolisChain(guide, u.random())).first;
+      const glm::vec2 point = pBsdf > 0.0f ? glm::vec2(std::min((uBsdf.x - pBsdf) / (1.0f - pBsdf), 0x1.fffffep-1f), uBsdf.y)
+                                           : u.bsdfDirection();
       ChainStats chain;
-      out.wi = it->second.next(guide, field_.settings(), u.random(), chain);
+      out.wi = it->second.next(guide, field_.settings(), u.random(), chain, &point);
       stats.proposals += chain.proposals;
       stats.accepted += chain.accepted;
     }

@@ -1,14 +1,17 @@
 // The guide distribution, its Metropolis chain and the cache-point lookup, against their definitions.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <iterator>
 #include <numbers>
 #include <string>
+#include <vector>
 #include "render/guide/guide_distribution.h"
 #include "render/guide/guide_field.h"
 #include "render/guide/metropolis_sampler.h"
 #include "render/sampling/equal_area_map.h"
+#include "render/sampling/pixel_sampler.h"
 #include "render/sampling/warps.h"
 #include "tests/unit/support.h"
 
@@ -233,6 +236,29 @@ TEST(Metropolis, IndependentChainsAreDistributedByThePdf) {
   }
 }
 
+// Four bins of the sphere (split by the cosine with an axis near the representatives') with their
+// pdf masses, and a check of correlated states' bin frequencies against them: each batch one row of
+// frequencies, its error from the batches' spread (batch means).
+struct CosineBins {
+  explicit CosineBins(const GuideDistribution& d) {
+    const double total = test::integrateSphere([&](const glm::vec3& w) { return double(d.pdf(w)); }, 512, 1024);
+    for (int b = 0; b < 4; ++b)
+      mass[b] = test::integrateSphere([&](const glm::vec3& w) { return bin(w) == b ? double(d.pdf(w)) : 0.0; }, 512, 1024) / total;
+  }
+  int bin(const glm::vec3& w) const { return std::clamp(int((glm::dot(w, axis) + 1.0f) * 2.0f), 0, 3); }
+  void expectBatchMeansNearMasses(const std::vector<std::array<double, 4>>& freq) const {
+    const double batches = double(freq.size());
+    for (int k = 0; k < 4; ++k) {
+      double mean = 0, var = 0;
+      for (const auto& f : freq) mean += f[size_t(k)] / batches;
+      for (const auto& f : freq) var += (f[size_t(k)] - mean) * (f[size_t(k)] - mean) / (batches - 1);
+      EXPECT_NEAR(mean, mass[k], 5.0 * std::sqrt(var / batches) + 1e-4) << "bin " << k;
+    }
+  }
+  glm::vec3 axis = glm::normalize(glm::vec3(0.3f, 0.8f, 0.2f));
+  double mass[4] = {};
+};
+
 TEST(Metropolis, LongChainVisitsBinsInProportion) {
   // One long chain (correlated states): bin frequencies against pdf mass, with batch-means errors.
   const GuideDistribution d(randomReps(5, 10, true), 30.0f * kDeg, 0.01f);
@@ -240,26 +266,40 @@ TEST(Metropolis, LongChainVisitsBinsInProportion) {
   Rng rng(11);
   MetropolisChain chain(d, rng);
   ChainStats stats;
-  // Four bins: the hemisphere around the representatives' axis split by cos theta.
-  const glm::vec3 axis = glm::normalize(glm::vec3(0.3f, 0.8f, 0.2f));
-  auto bin = [&](const glm::vec3& w) { return std::clamp(int((glm::dot(w, axis) + 1.0f) * 2.0f), 0, 3); };
-  double mass[4] = {};
-  const double total = test::integrateSphere([&](const glm::vec3& w) { return double(d.pdf(w)); }, 512, 1024);
-  for (int b = 0; b < 4; ++b)
-    mass[b] = test::integrateSphere([&](const glm::vec3& w) { return bin(w) == b ? double(d.pdf(w)) : 0.0; }, 512, 1024) / total;
+  const CosineBins bins(d);
   const int batches = 50, perBatch = 20000;
   std::vector<std::array<double, 4>> freq(batches);
   for (int b = 0; b < batches; ++b) {
     std::array<double, 4> f{};
-    for (int i = 0; i < perBatch; ++i) f[size_t(bin(chain.next(d, settings, rng, stats)))] += 1.0 / perBatch;
+    for (int i = 0; i < perBatch; ++i) f[size_t(bins.bin(chain.next(d, settings, rng, stats)))] += 1.0 / perBatch;
     freq[size_t(b)] = f;
   }
-  for (int k = 0; k < 4; ++k) {
-    double mean = 0, var = 0;
-    for (const auto& f : freq) mean += f[size_t(k)] / batches;
-    for (const auto& f : freq) var += (f[size_t(k)] - mean) * (f[size_t(k)] - mean) / (batches - 1);
-    EXPECT_NEAR(mean, mass[k], 5.0 * std::sqrt(var / batches) + 1e-4) << "bin " << k;
+  bins.expectBatchMeansNearMasses(freq);
+}
+
+TEST(Metropolis, ChainsProposingFromPixelsStratifiedPairsKeepThePdf) {
+  // As the renderer runs them: a chain per tile and pass, started at an exact sample, whose step for
+  // each pixel of the tile proposes from that pixel's stratified pair of the pass (the BSDF
+  // direction's slot). Bin frequencies against pdf mass, batch means over the chains.
+  const GuideDistribution d(randomReps(5, 10, true), 30.0f * kDeg, 0.01f);
+  GuideSettings settings;
+  Rng rng(12);
+  ChainStats stats;
+  const CosineBins bins(d);
+  const int passes = 200, pixels = 256;
+  std::vector<std::array<double, 4>> freq(passes);
+  for (int pass = 0; pass < passes; ++pass) {
+    MetropolisChain chain(d, rng);
+    std::array<double, 4> f{};
+    for (int p = 0; p < pixels; ++p) {
+      PixelSampler sampler(5, uint64_t(p), uint64_t(pass));
+      VertexSamples u(sampler, 0);
+      const glm::vec2 point = u.bsdfDirection();
+      f[size_t(bins.bin(chain.next(d, settings, rng, stats, &point)))] += 1.0 / pixels;
+    }
+    freq[size_t(pass)] = f;
   }
+  bins.expectBatchMeansNearMasses(freq);
 }
 
 TEST(Metropolis, ChainsFromABadStartForgetItAndFollowThePdf) {
