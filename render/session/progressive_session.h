@@ -8,8 +8,9 @@
 //                `previewPasses` and `previewSeconds`, with fewer clusters per pixel)
 //   3. refine    the guide (guided modes), then path-traced passes into the mode's own film, until
 //                `maxSpp`
-// The shown image is the newest stage with something to show; the path-traced film takes over once
-// it has `handoverSpp` samples, so the picture is never black and never steps back. Films are kept
+// The shown image is the newest stage with something to show; the path-traced film fades in over the
+// preview from its first pass and has taken over at `handoverSpp` samples, so the picture is never
+// black, never steps back to much more noise and never waits behind a still preview. Films are kept
 // per mode while the camera stays, so flipping back to a mode shows its image at once.
 #pragma once
 #include <atomic>
@@ -39,7 +40,7 @@ struct SessionSettings {
   int threads = 0;           // render workers; 0: every core
   int previewPasses = 4;      // refining modes: preview passes at most (fewer clusters per pixel than `preview` mode)
   double previewSeconds = 1.0;  // refining modes: ... and a pass begun only if it should end by then (one at least)
-  int handoverSpp = 16;      // path-traced samples before the display leaves the preview
+  int handoverSpp = 16;      // path-traced samples at which the display has left the preview (a fade until then)
   int maxSpp = 1 << 16;      // the controller idles after this many path-traced samples
   int maxSlices = 384;       // slices (cache points) per view at most; 0: preview.slices alone decides
   bool coarsePreview = true;  // show a coarse preview pass before the full clustering

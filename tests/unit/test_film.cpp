@@ -2,6 +2,7 @@
 // same as adding them here, and at weight w each counts w times a sample of its own, in the mean and
 // in the variance's moments alike (`--join-depth auto` adds its trial passes so, at weight 1).
 #include <gtest/gtest.h>
+#include "render/film/crossfade.h"
 #include "render/film/film.h"
 
 namespace vpl {
@@ -56,4 +57,18 @@ TEST(Film, AFilmAddedAtAWeightCountsThatManyTimesInTheMean) {
 }
 
 }  // namespace
+TEST(Crossfade, MixesInProportionAndEndsAtTheTargetExactly) {
+  Image from(2, 1), to(2, 1);
+  from.pixels = {glm::vec3(1.0f, 2.0f, 0.0f), glm::vec3(4.0f)};
+  to.pixels = {glm::vec3(3.0f, 0.0f, 0.5f), glm::vec3(0.1f)};
+  const Image quarter = crossfade(from, to, 0.25f);
+  EXPECT_FLOAT_EQ(quarter.pixels[0].x, 1.5f);
+  EXPECT_FLOAT_EQ(quarter.pixels[0].y, 1.5f);
+  EXPECT_FLOAT_EQ(quarter.pixels[1].z, 3.025f);
+  EXPECT_EQ(crossfade(from, to, 0.0f).pixels, from.pixels);
+  EXPECT_EQ(crossfade(from, to, 1.0f).pixels, to.pixels);
+  EXPECT_EQ(crossfade(from, to, 7.0f).pixels, to.pixels);  // past the hand-over
+  EXPECT_EQ(crossfade(Image(), to, 0.5f).pixels, to.pixels);  // nothing to fade from
+}
+
 }  // namespace vpl

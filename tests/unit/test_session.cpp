@@ -211,6 +211,29 @@ TEST(Session, FlippingBackToAModeShowsItsOwnFilmAtOnce) {
   EXPECT_EQ(session.stats().restarts, 1u);
 }
 
+TEST(Session, TheFilmFadesInOverThePreviewBeforeTheHandover) {
+  // Three passes of a film that hands over at four: the last frame is the refinement's (its spp),
+  // three quarters the film (the same seed's film alone, handing over at one) and one quarter
+  // the preview. The preview used to stay on screen, untouched, until the hand-over.
+  const auto scene = cornell();
+  SessionSettings s = small(SamplingMode::Brdf, 3);
+  s.handoverSpp = 4;
+  ProgressiveSession fading(scene, defaultCamera(scene->data()), s);
+  const Image faded = finalImage(fading);
+  EXPECT_EQ(fading.stats().spp, 3);  // the preview shows at most its two passes
+  s.handoverSpp = 1;
+  ProgressiveSession filmOnly(scene, defaultCamera(scene->data()), s);
+  const Image film = finalImage(filmOnly);
+  EXPECT_GT(relMse(faded, film), 0.0);
+  double previewMean = 0.0;
+  for (size_t i = 0; i < film.pixels.size(); ++i) {
+    const glm::vec3 preview = (faded.pixels[i] - 0.75f * film.pixels[i]) / 0.25f;
+    ASSERT_GE(std::min({preview.x, preview.y, preview.z}), -1e-4f) << "pixel " << i;
+    previewMean += double(preview.x + preview.y + preview.z) / double(film.pixels.size());
+  }
+  EXPECT_GT(previewMean, 0.0);
+}
+
 TEST(Session, ShowsAFullFrameFirstAndNeverANonFiniteOne) {
   const auto scene = cornell();
   SessionSettings s = small(SamplingMode::Mis, 6);
