@@ -240,7 +240,8 @@ TEST(Metropolis, IndependentChainsAreDistributedByThePdf) {
 // pdf masses, and a check of correlated states' bin frequencies against them: each batch one row of
 // frequencies, its error from the batches' spread (batch means).
 struct CosineBins {
-  explicit CosineBins(const GuideDistribution& d) {
+  explicit CosineBins(const GuideDistribution& d, const glm::vec3& binAxis = glm::vec3(0.3f, 0.8f, 0.2f))
+      : axis(glm::normalize(binAxis)) {
     const double total = test::integrateSphere([&](const glm::vec3& w) { return double(d.pdf(w)); }, 512, 1024);
     for (int b = 0; b < 4; ++b)
       mass[b] = test::integrateSphere([&](const glm::vec3& w) { return bin(w) == b ? double(d.pdf(w)) : 0.0; }, 512, 1024) / total;
@@ -255,7 +256,7 @@ struct CosineBins {
       EXPECT_NEAR(mean, mass[k], 5.0 * std::sqrt(var / batches) + 1e-4) << "bin " << k;
     }
   }
-  glm::vec3 axis = glm::normalize(glm::vec3(0.3f, 0.8f, 0.2f));
+  glm::vec3 axis;
   double mass[4] = {};
 };
 
@@ -285,21 +286,24 @@ TEST(Metropolis, ChainsProposingFromPixelsStratifiedPairsKeepThePdf) {
   GuideSettings settings;
   Rng rng(12);
   ChainStats stats;
-  const CosineBins bins(d);
-  const int passes = 200, pixels = 256;
-  std::vector<std::array<double, 4>> freq(passes);
+  // Bins along the representatives' axis, and along z, which the uniform proposal's first number sets
+  // (a step that let that number decide its acceptance too would lean towards +z).
+  const CosineBins bins[2] = {CosineBins(d), CosineBins(d, glm::vec3(0.0f, 0.0f, 1.0f))};
+  const int passes = 400, pixels = 256;
+  std::vector<std::array<double, 4>> freq[2];
   for (int pass = 0; pass < passes; ++pass) {
     MetropolisChain chain(d, rng);
-    std::array<double, 4> f{};
+    std::array<double, 4> f[2]{};
     for (int p = 0; p < pixels; ++p) {
       PixelSampler sampler(5, uint64_t(p), uint64_t(pass));
       VertexSamples u(sampler, 0);
       const glm::vec2 point = u.bsdfDirection();
-      f[size_t(bins.bin(chain.next(d, settings, rng, stats, &point)))] += 1.0 / pixels;
+      const glm::vec3 w = chain.next(d, settings, rng, stats, &point);
+      for (int b = 0; b < 2; ++b) f[b][size_t(bins[b].bin(w))] += 1.0 / pixels;
     }
-    freq[size_t(pass)] = f;
+    for (int b = 0; b < 2; ++b) freq[b].push_back(f[b]);
   }
-  bins.expectBatchMeansNearMasses(freq);
+  for (int b = 0; b < 2; ++b) bins[b].expectBatchMeansNearMasses(freq[b]);
 }
 
 TEST(Metropolis, ChainsFromABadStartForgetItAndFollowThePdf) {
