@@ -37,6 +37,7 @@
 #include <optional>
 #include <vector>
 #include <glm/glm.hpp>
+#include "render/core/color.h"
 #include "render/scene/emitters.h"
 #include "render/scene/render_scene.h"
 
@@ -81,14 +82,18 @@ class EmitterGuide {
   // The same for a light path's start e (EmitterSet::nextEventPdfTimesCos's meaning: times the
   // cosine at the light).
   float nextEventPdfTimesCos(const glm::vec3& p, const EmissionSample& e) const;
+  // What a sample that arrived records: the luminance of its radiance times the receiver's cosine
+  // over its density.
+  static float arrivalValue(const glm::vec3& radiance, float cosReceiver, float pdf) {
+    return luminance(radiance) * cosReceiver / pdf;
+  }
   // A sample's shadow ray is traced ...
   void attempted(uint32_t slot) const {
     if (slot == UINT32_MAX) return;
     const uint32_t region = slot / uint32_t(cells_);
     if (state_[region] == State::Undecided) lane().attempts[region].fetch_add(1, std::memory_order_relaxed);
   }
-  // ... and arrived, bringing back `value` (luminance of its radiance times the receiver's cosine
-  // over its density). Any thread, any order.
+  // ... and arrived, bringing back `value` (arrivalValue()). Any thread, any order.
   void arrived(uint32_t slot, float value) const {
     if (slot == UINT32_MAX) return;
     Lane& l = lane();

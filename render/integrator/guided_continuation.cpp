@@ -65,8 +65,14 @@ bool GuidedContinuation::sample(const SurfaceHit& hit, const Bsdf& bsdf, const g
   } else {
     const GuideDistribution& guide = guideAt(c);
     const bool revisit = std::find(chainsUsedByPath_.begin(), chainsUsedByPath_.end(), c) != chainsUsedByPath_.end();
+    // The guide's stratified pair: the rest of the BSDF's number past its share, or all of a fresh one
+    // where none was drawn above (the chain's modes, whose BSDF has no share).
+    const auto guidePair = [&] {
+      return pBsdf > 0.0f || shared ? glm::vec2(std::min((uBsdf.x - pBsdf) / (1.0f - pBsdf), 0x1.fffffep-1f), uBsdf.y)
+                                    : u.bsdfDirection();
+    };
     if (shared) {
-      out.wi = guide.sample(glm::vec2(std::min((uBsdf.x - pBsdf) / (1.0f - pBsdf), 0x1.fffffep-1f), uBsdf.y));
+      out.wi = guide.sample(guidePair());
     } else if (mode_ == SamplingMode::Mixture || revisit) {
       out.wi = guide.sample(u.guideCell(), u.guidePoint());
     } else {
@@ -76,8 +82,7 @@ bool GuidedContinuation::sample(const SurfaceHit& hit, const Bsdf& bsdf, const g
       chainsUsedByPath_.push_back(c);
       auto it = chains_.find(c);
       if (it == chains_.end()) it = chains_.emplace(c, MetropolisChain(guide, u.random())).first;
-      const glm::vec2 point = pBsdf > 0.0f ? glm::vec2(std::min((uBsdf.x - pBsdf) / (1.0f - pBsdf), 0x1.fffffep-1f), uBsdf.y)
-                                           : u.bsdfDirection();
+      const glm::vec2 point = guidePair();
       ChainStats chain;
       out.wi = it->second.next(guide, field_.settings(), u.random(), chain, &point);
       stats.proposals += chain.proposals;

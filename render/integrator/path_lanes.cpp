@@ -373,7 +373,7 @@ void PathLanes::Batch::bounce() {
                                                                   depth_[k], sums(k), bsdfContinuation_)
                   : ls->delta ? 1.0f : powerHeuristic(ls->pdf, cosineHemispherePdf(cosIn));
     contribution[k] = f * ls->radiance * (w / ls->pdf);
-    arrival[k] = luminance(ls->radiance) * cosReceiver / ls->pdf;
+    arrival[k] = EmitterGuide::arrivalValue(ls->radiance, cosReceiver, ls->pdf);
     slot[k] = ls->guideSlot;
     tested[k] = -1;
   }
@@ -413,7 +413,7 @@ void PathLanes::Batch::bounce() {
       slot[k] = lights.slot[k];  // a learned region's: its sample's arrival is recorded
       if (lights.learned[k]) {
         guide_->attempted(slot[k]);
-        arrival[k] = luminance(emitted) * cosReceiver[k] / lights.pdf[k];
+        arrival[k] = EmitterGuide::arrivalValue(emitted, cosReceiver[k], lights.pdf[k]);
       }
       tested[k] = -1;
     }

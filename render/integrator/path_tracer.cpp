@@ -279,7 +279,7 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
           ++stats.rays;
           if (emitterGuide_) emitterGuide_->attempted(ls->guideSlot);
           if (!scene_.accel().occluded(spawnShadowRay(surface, ls->wi, ls->distance))) {
-            if (emitterGuide_) emitterGuide_->arrived(ls->guideSlot, luminance(ls->radiance) * cosReceiver / ls->pdf);
+            if (emitterGuide_) emitterGuide_->arrived(ls->guideSlot, EmitterGuide::arrivalValue(ls->radiance, cosReceiver, ls->pdf));
             const float w = nextEventWeight(*ls, surface, bsdf, wo, depth, path.mis, continuation);
             L += beta * f * ls->radiance * (w / ls->pdf);
             // At the camera ray's hit both depths' camera sums are 0, so the weights are the same.
