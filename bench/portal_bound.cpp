@@ -44,13 +44,13 @@ class RectangleContinuation final : public ContinuationSampler {
       out.wi = glm::normalize(rect_.centre + u.x * rect_.u + u.y * rect_.v - hit.position);
     }
     ++stats.bsdfSamples;
-    out.pdf = pdf(hit, bsdf, wo, out.wi);
+    out.pdf = pdf(hit, bsdf, wo, out.wi, bsdf.pdf(wo, out.wi));
     return out.pdf > 0.0f;
   }
 
-  float pdf(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, const glm::vec3& wi) override {
-    if (!faces(hit)) return bsdf.pdf(wo, wi);
-    return 0.5f * bsdf.pdf(wo, wi) + 0.5f * rectanglePdf(hit.position, wi);
+  float pdf(const SurfaceHit& hit, const Bsdf&, const glm::vec3&, const glm::vec3& wi, float bsdfPdf) override {
+    if (!faces(hit)) return bsdfPdf;
+    return 0.5f * bsdfPdf + 0.5f * rectanglePdf(hit.position, wi);
   }
 
  private:

@@ -97,18 +97,19 @@ bool GuidedContinuation::sample(const SurfaceHit& hit, const Bsdf& bsdf, const g
 }
 
 GuidedContinuation::Densities GuidedContinuation::densities(int c, const Bsdf& bsdf, const glm::vec3& wo,
-                                                            const glm::vec3& wi) const {
+                                                            const glm::vec3& wi, float bsdfPdf) const {
   const float pBsdf = bsdfProbability(c);
   Densities d;
-  d.bsdf = pBsdf > 0.0f ? bsdf.pdf(wo, wi) : 0.0f;
+  d.bsdf = pBsdf > 0.0f ? (bsdfPdf >= 0.0f ? bsdfPdf : bsdf.pdf(wo, wi)) : 0.0f;
   d.guide = pBsdf < 1.0f ? guideAt(c).pdf(wi) : 0.0f;
   d.mixture = pBsdf >= 1.0f ? d.bsdf : pBsdf > 0.0f ? pBsdf * d.bsdf + (1.0f - pBsdf) * d.guide : d.guide;
   return d;
 }
 
-float GuidedContinuation::pdf(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, const glm::vec3& wi) {
+float GuidedContinuation::pdf(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, const glm::vec3& wi,
+                              float bsdfPdf) {
   const int c = servingCachePoint(hit, bsdf);
-  return c < 0 ? bsdf.pdf(wo, wi) : densities(c, bsdf, wo, wi).mixture;
+  return c < 0 ? bsdfPdf : densities(c, bsdf, wo, wi, bsdfPdf).mixture;
 }
 
 void GuidedContinuation::endPath(const glm::vec3& firstContinuation) {

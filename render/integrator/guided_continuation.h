@@ -27,7 +27,7 @@ class GuidedContinuation final : public ContinuationSampler {
 
   bool sample(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, VertexSamples& u, DirectionSample& out,
               PathStats& stats) override;
-  float pdf(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, const glm::vec3& wi) override;
+  float pdf(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, const glm::vec3& wi, float bsdfPdf) override;
   void beginPath(uint64_t pixel) override {
     chainsUsedByPath_.clear();
     pixel_ = pixel;
@@ -42,11 +42,12 @@ class GuidedContinuation final : public ContinuationSampler {
  private:
   // Probability of drawing from the BSDF at a vertex served by cache point c.
   float bsdfProbability(int c) const;
-  // The mixture density of a direction, with its two parts for the learner.
+  // The mixture density of a direction, with its two parts for the learner; bsdfPdf is
+  // bsdf.pdf(wo, wi) where the caller has it, negative where densities() must evaluate it.
   struct Densities {
     float bsdf = 0.0f, guide = 0.0f, mixture = 0.0f;
   };
-  Densities densities(int c, const Bsdf& bsdf, const glm::vec3& wo, const glm::vec3& wi) const;
+  Densities densities(int c, const Bsdf& bsdf, const glm::vec3& wo, const glm::vec3& wi, float bsdfPdf = -1.0f) const;
   // The guide of cache point c for this pass.
   const GuideDistribution& guideAt(int c) const { return guides_ ? guides_->distribution(c) : field_.point(c).distribution; }
   // Whether this vertex reports to the learners: the first of its path, served by cache point c.

@@ -370,7 +370,8 @@ void PathLanes::Batch::bounce() {
     shadow.dir_x[k] = r.direction.x, shadow.dir_y[k] = r.direction.y, shadow.dir_z[k] = r.direction.z;
     shadow.tfar[k] = r.tMax;
     const float w = connections_ ? lanes_.tracer_.nextEventWeight(*ls, surfaces_[k], *bsdfs_[k], wo(k),
-                                                                  depth_[k], sums(k), bsdfContinuation_)
+                                                                  bsdfs_[k]->evalPdf(wo(k), ls->wi), depth_[k], sums(k),
+                                                                  bsdfContinuation_)
                   : ls->delta ? 1.0f : powerHeuristic(ls->pdf, cosineHemispherePdf(cosIn));
     contribution[k] = f * ls->radiance * (w / ls->pdf);
     arrival[k] = EmitterGuide::arrivalValue(ls->radiance, cosReceiver, ls->pdf);

@@ -30,8 +30,8 @@ float bidirectionalWeight(float others) { return std::isfinite(others) ? 1.0f / 
 // connections: the first vertex's own strategy (the guide), BSDF sampling past it, because that is
 // what the light side, which cannot know a vertex's depth, evaluates for its vertices.
 float cameraMisPdf(int depth, ContinuationSampler& continuation, const SurfaceHit& surface, const Bsdf& bsdf,
-                   const glm::vec3& wo, const glm::vec3& wi) {
-  return depth == 0 ? continuation.pdf(surface, bsdf, wo, wi) : bsdf.pdf(wo, wi);
+                   const glm::vec3& wo, const glm::vec3& wi, float bsdfPdf) {
+  return depth == 0 ? continuation.pdf(surface, bsdf, wo, wi, bsdfPdf) : bsdfPdf;
 }
 
 }  // namespace
@@ -68,8 +68,8 @@ bool BsdfContinuation::sample(const SurfaceHit&, const Bsdf& bsdf, const glm::ve
   return true;
 }
 
-float BsdfContinuation::pdf(const SurfaceHit&, const Bsdf& bsdf, const glm::vec3& wo, const glm::vec3& wi) {
-  return bsdf.pdf(wo, wi);
+float BsdfContinuation::pdf(const SurfaceHit&, const Bsdf&, const glm::vec3&, const glm::vec3&, float bsdfPdf) {
+  return bsdfPdf;
 }
 
 PathTracer::PathTracer(const RenderScene& scene, const PathTracerSettings& settings, const IrradianceGrid* irradiance,
@@ -111,13 +111,14 @@ float PathTracer::emitterHitWeight(const SurfaceHit& surface, const glm::vec3& w
 }
 
 float PathTracer::nextEventWeight(const LightSample& ls, const SurfaceHit& surface, const Bsdf& bsdf, const glm::vec3& wo,
-                                  int depth, const MisSums& sums, ContinuationSampler& continuation) const {
-  if (!connections_) return ls.delta ? 1.0f : powerHeuristic(ls.pdf, continuation.pdf(surface, bsdf, wo, ls.wi));
+                                  const Bsdf::Evaluation& toLight, int depth, const MisSums& sums,
+                                  ContinuationSampler& continuation) const {
+  if (!connections_) return ls.delta ? 1.0f : powerHeuristic(ls.pdf, continuation.pdf(surface, bsdf, wo, ls.wi, toLight.pdf));
   // Densities of punctual lights in the solid angle of the point they sit at (Georgiev 2012).
   const float directPdf = ls.delta && std::isfinite(ls.distance) ? ls.pdf * ls.distance * ls.distance : ls.pdf;
-  const float wLight = ls.delta ? 0.0f : connectionMis(cameraMisPdf(depth, continuation, surface, bsdf, wo, ls.wi) / directPdf);
+  const float wLight = ls.delta ? 0.0f : connectionMis(cameraMisPdf(depth, continuation, surface, bsdf, wo, ls.wi, toLight.pdf) / directPdf);
   // The light path that starts at the sampled point and reaches here, then shifts along the camera side.
-  const float cameraSide = sums.dVCM + (sums.dVC > 0.0f ? sums.dVC * connectionMis(bsdf.pdf(ls.wi, wo)) : 0.0f);
+  const float cameraSide = sums.dVCM + (sums.dVC > 0.0f ? sums.dVC * connectionMis(toLight.pdfReverse) : 0.0f);
   const float cosCamera = std::abs(glm::dot(surface.geometricNormal, ls.wi));
   const float wCamera = cameraSide > 0.0f ? connectionMis(ls.emissionPdf * cosCamera / (directPdf * ls.cosLight)) * cameraSide : 0.0f;
   return bidirectionalWeight(wLight + wCamera);
@@ -143,14 +144,13 @@ glm::vec3 PathTracer::unoccludedJoin(const SurfaceHit& surface, const Bsdf& bsdf
   // The camera's density is cameraMisPdf's, with the BSDF's taken from the evaluation above. At the
   // first vertex the camera side has no other strategy (no light tracing to the camera): cameraSide
   // is 0 and its densities are not needed.
-  const float cameraPdf = depth == 0 ? continuation.pdf(surface, bsdf, wo, w) : camera.pdf;
-  // The reverse densities, evaluated once when either weight needs them (a counterfactual's too).
-  float reverseCamera = -1.0f, reverseLight = -1.0f;
+  const float cameraPdf = depth == 0 ? continuation.pdf(surface, bsdf, wo, w, camera.pdf) : camera.pdf;
+  // The reverse densities came with the evaluations (a counterfactual's weight uses them too).
+  const float reverseCamera = connectionMis(camera.pdfReverse);
+  const float reverseLight = connectionMis(light.pdfReverse * cosCamera / dist2);
   const auto weightFor = [&](const MisSums& sums, int limit) {
     const float wLight = connectionMis(cameraPdf * cosLight / dist2) * LightVertexCache::lightSideSum(y, depth, light.pdf, limit);
-    if (sums.dVC > 0.0f && reverseCamera < 0.0f) reverseCamera = connectionMis(bsdf.pdf(w, wo));
     const float cameraSide = sums.dVCM + (sums.dVC > 0.0f ? sums.dVC * reverseCamera : 0.0f);
-    if (cameraSide > 0.0f && reverseLight < 0.0f) reverseLight = connectionMis(y.bsdf.pdf(y.wIn, -w) * cosCamera / dist2);
     const float wCamera = cameraSide > 0.0f ? reverseLight * cameraSide : 0.0f;
     // Over this join's own count (the other joins' counts are in the partial sums).
     return bidirectionalWeight((wLight + wCamera) / connections_->misFactor(y));
@@ -274,16 +274,17 @@ glm::vec3 PathTracer::radiance(const Ray& cameraRay, PixelSampler& sampler, Cont
                                     : emitters.sampleStratified(surface.position, u.lightPoint(), lightChoice);
       if (ls) {
         const float cosReceiver = glm::dot(ls->wi, surface.geometricNormal);
-        const glm::vec3 f = cosReceiver > 0.0f ? bsdf.eval(wo, ls->wi) : glm::vec3(0.0f);
+        const Bsdf::Evaluation toLight = cosReceiver > 0.0f ? bsdf.evalPdf(wo, ls->wi) : Bsdf::Evaluation{};
+        const glm::vec3& f = toLight.f;
         if (!isBlack(f)) {
           ++stats.rays;
           if (emitterGuide_) emitterGuide_->attempted(ls->guideSlot);
           if (!scene_.accel().occluded(spawnShadowRay(surface, ls->wi, ls->distance))) {
             if (emitterGuide_) emitterGuide_->arrived(ls->guideSlot, EmitterGuide::arrivalValue(ls->radiance, cosReceiver, ls->pdf));
-            const float w = nextEventWeight(*ls, surface, bsdf, wo, depth, path.mis, continuation);
+            const float w = nextEventWeight(*ls, surface, bsdf, wo, toLight, depth, path.mis, continuation);
             L += beta * f * ls->radiance * (w / ls->pdf);
             // At the camera ray's hit both depths' camera sums are 0, so the weights are the same.
-            if (alt) altL += beta * f * ls->radiance * ((depth == 0 ? w : nextEventWeight(*ls, surface, bsdf, wo, depth, path.alt, continuation)) / ls->pdf);
+            if (alt) altL += beta * f * ls->radiance * ((depth == 0 ? w : nextEventWeight(*ls, surface, bsdf, wo, toLight, depth, path.alt, continuation)) / ls->pdf);
           }
         }
       }

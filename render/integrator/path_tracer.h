@@ -88,8 +88,9 @@ class ContinuationSampler {
   // Picks a direction at this vertex from its numbers `u`; returns false when the path should end.
   virtual bool sample(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, VertexSamples& u,
                       DirectionSample& out, PathStats& stats) = 0;
-  // Density with which sample() would return wi at this vertex.
-  virtual float pdf(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, const glm::vec3& wi) = 0;
+  // Density with which sample() would return wi at this vertex; bsdfPdf is bsdf.pdf(wo, wi), which
+  // every caller has from its own evaluation of the BSDF (Bsdf::evalPdf).
+  virtual float pdf(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, const glm::vec3& wi, float bsdfPdf) = 0;
 };
 
 // Plain BSDF importance sampling (the `brdf` mode).
@@ -97,7 +98,7 @@ class BsdfContinuation final : public ContinuationSampler {
  public:
   bool sample(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, VertexSamples& u, DirectionSample& out,
               PathStats& stats) override;
-  float pdf(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, const glm::vec3& wi) override;
+  float pdf(const SurfaceHit& hit, const Bsdf& bsdf, const glm::vec3& wo, const glm::vec3& wi, float bsdfPdf) override;
 };
 
 class EmitterGuide;
@@ -157,10 +158,11 @@ class PathTracer {
   };
   // MIS weights of an emitter hit and of a next-event sample: against each other alone, or with
   // connections against every join that makes the same path. `sums`: the path's own, or those of a
-  // counterfactual join depth.
+  // counterfactual join depth. `toLight`: bsdf.evalPdf(wo, ls.wi).
   float emitterHitWeight(const SurfaceHit& surface, const glm::vec3& wo, const PathPoint& path, const MisSums& sums) const;
   float nextEventWeight(const LightSample& ls, const SurfaceHit& surface, const Bsdf& bsdf, const glm::vec3& wo,
-                        int depth, const MisSums& sums, ContinuationSampler& continuation) const;
+                        const Bsdf::Evaluation& toLight, int depth, const MisSums& sums,
+                        ContinuationSampler& continuation) const;
   // The MIS-weighted contribution of joining camera vertex `surface` (at `depth`, with the sums `mis`)
   // to light vertex y, picked with weight `scale` (without the path's throughput), if `shadow`
   // arrives; 0 when y is too long or faces away. With a counterfactual depth (`altLimit`, the sums

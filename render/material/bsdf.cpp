@@ -122,11 +122,44 @@ Bsdf::Evaluation Bsdf::evalPdf(const glm::vec3& wo, const glm::vec3& wi) const {
   if (lambertian_) {
     const float cosIn = glm::dot(wi, frame_.n);
     if (cosOutgoing(wo) <= 0.0f || cosIn <= 0.0f) return {};
-    return {diffuseScale_ * cosIn, cosineHemispherePdf(cosIn)};
+    // pdf(wi, wo) takes wo's cosine as pdf() takes wi's (a bound one may differ in its last bit).
+    return {diffuseScale_ * cosIn, cosineHemispherePdf(cosIn), cosineHemispherePdf(glm::dot(wo, frame_.n))};
   }
-  const Outgoing o = outgoing(wo);
-  const glm::vec3 local = frame_.toLocal(wi);
-  return {evalLocal(o, local), pdfLocal(o, local)};
+  return evalPdfLocal(outgoing(wo), frame_.toLocal(wi));
+}
+
+// evalLocal, pdfLocal and pdfLocal with the directions swapped, in their own arithmetic: wi's albedo,
+// lobe probability and Smith Lambda are what outgoingTerms(wi) would give, the half vector and D are
+// the same both ways.
+Bsdf::Evaluation Bsdf::evalPdfLocal(const Outgoing& o, const glm::vec3& wi) const {
+  const glm::vec3& wo = o.local;
+  if (wo.z <= 0.0f || wi.z <= 0.0f) return {};
+  glm::vec3 albedoIn(0.0f);
+  float lambdaIn = 0.0f, specularIn = 0.0f;
+  if (hasSpecular()) {
+    albedoIn = specularAlbedo(wi.z);
+    lambdaIn = ggx::lambda(wi, params_.alpha);
+    specularIn = specularProbability(albedoIn);
+  }
+  Evaluation e;
+  if (!isBlack(diffuseScale_))
+    e.f += hasSpecular() ? diffuseScale_ * (glm::vec3(1.0f) - o.albedo) * (glm::vec3(1.0f) - albedoIn) * wi.z
+                         : diffuseScale_ * wi.z;
+  e.pdf = (1.0f - o.specularProbability) * cosineHemispherePdf(wi.z);
+  e.pdfReverse = (1.0f - specularIn) * cosineHemispherePdf(wo.z);
+  if (hasSpecular()) {
+    glm::vec3 h = wo + wi;
+    const float len = glm::length(h);
+    if (len > 1e-8f) {
+      h /= len;
+      const float d = ggx::D(h, params_.alpha);
+      const float g2 = 1.0f / (1.0f + o.lambda + lambdaIn);
+      e.f += ggx::schlick(params_.f0, params_.f90, glm::dot(wo, h)) * (d * g2 / (4.0f * wo.z));
+      if (o.specularProbability > 0.0f) e.pdf += o.specularProbability * ((1.0f / (1.0f + o.lambda)) * d / (4.0f * wo.z));
+      if (specularIn > 0.0f) e.pdfReverse += specularIn * ((1.0f / (1.0f + lambdaIn)) * d / (4.0f * wi.z));
+    }
+  }
+  return e;
 }
 
 std::optional<BsdfSample> Bsdf::sample(const glm::vec3& woWorld, glm::vec2 u, float uLobe) const {
@@ -156,12 +189,12 @@ std::optional<BsdfSample> Bsdf::sampleLobe(const Outgoing& o, glm::vec2 u, bool 
     wi = sampleCosineHemisphere(u);  // the diffuse lobe beside a specular one (a lone one: sampleLambertian)
   }
   if (wi.z <= 0.0f) return std::nullopt;
-  const float pdf = pdfLocal(o, wi);
-  if (!(pdf > 0.0f) || !std::isfinite(pdf)) return std::nullopt;
+  const Evaluation e = evalPdfLocal(o, wi);
+  if (!(e.pdf > 0.0f) || !std::isfinite(e.pdf)) return std::nullopt;
   BsdfSample s;
   s.wi = glm::normalize(frame_.toWorld(wi));
-  s.pdf = pdf;
-  s.weight = evalLocal(o, wi) / pdf;
+  s.pdf = e.pdf;
+  s.weight = e.f / e.pdf;
   if (!isFiniteNonNegative(s.weight)) return std::nullopt;
   return s;
 }

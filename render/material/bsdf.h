@@ -52,11 +52,14 @@ class Bsdf {
   glm::vec3 eval(const glm::vec3& wo, const glm::vec3& wi) const;
   // Density of sample() per unit solid angle.
   float pdf(const glm::vec3& wo, const glm::vec3& wi) const;
-  // Both at once, from one change of frame and one set of wo's terms: a bidirectional join needs
-  // them at a vertex whose BSDF is not bound to that wo.
+  // eval(wo, wi), pdf(wo, wi) and pdf(wi, wo) at once, equal to theirs bit for bit: one change of
+  // frame, one microfacet density, and wi's terms (which f's coupling and masking need anyway) serve
+  // the reverse density too. A light sample or a join needs all three (the reverse for the MIS
+  // weights of the paths that bidirectional sampling makes from the other end).
   struct Evaluation {
     glm::vec3 f{0.0f};
     float pdf = 0.0f;
+    float pdfReverse = 0.0f;
   };
   Evaluation evalPdf(const glm::vec3& wo, const glm::vec3& wi) const;
   // Picks a lobe with uLobe, then samples it (GGX: visible normals, Heitz 2018). Empty if no direction.
@@ -104,6 +107,7 @@ class Bsdf {
   std::optional<BsdfSample> sampleLobe(const Outgoing& wo, glm::vec2 u, bool specular) const;
   glm::vec3 evalLocal(const Outgoing& wo, const glm::vec3& wi) const;
   float pdfLocal(const Outgoing& wo, const glm::vec3& wi) const;
+  Evaluation evalPdfLocal(const Outgoing& wo, const glm::vec3& wi) const;
 };
 
 // f0 of the glTF metallic-roughness model with KHR_materials_specular / KHR_materials_ior.

@@ -106,6 +106,30 @@ TEST(Bsdf, Reciprocity) {
   }
 }
 
+// evalPdf is what a light sample and a join ask for: it must give eval, pdf and the reverse pdf
+// exactly, so that the tracer's images stay the same whichever of them it calls.
+TEST(Bsdf, EvalPdfGivesEvalAndBothDensitiesExactly) {
+  Rng rng(11);
+  std::vector<Case> all = cases();
+  all.push_back({"lambert", glm::vec3(0.6f, 0.3f, 0.1f), glm::vec3(0.0f), 0.0f, 0.5f});
+  for (const Case& c : all) {
+    const Bsdf bsdf = makeBsdf(c);
+    for (int i = 0; i < 300; ++i) {
+      // Both hemispheres for each direction: below the surface everything is 0.
+      const glm::vec3 a = bsdf.frame().toWorld(directionWithCos(-0.2f + 1.2f * rng.uniform(), 6.283f * rng.uniform()));
+      const glm::vec3 b = bsdf.frame().toWorld(directionWithCos(-0.2f + 1.2f * rng.uniform(), 6.283f * rng.uniform()));
+      Bsdf bound = bsdf;
+      bound.bindOutgoing(a);
+      for (const Bsdf* at : {&bsdf, static_cast<const Bsdf*>(&bound)}) {
+        const Bsdf::Evaluation e = at->evalPdf(a, b);
+        ASSERT_EQ(e.f, bsdf.eval(a, b)) << c.name;
+        ASSERT_EQ(e.pdf, bsdf.pdf(a, b)) << c.name;
+        ASSERT_EQ(e.pdfReverse, bsdf.pdf(b, a)) << c.name;
+      }
+    }
+  }
+}
+
 // Directional albedo by importance sampling: mean of the sample weights (the estimator the path tracer uses).
 glm::dvec3 albedo(const Bsdf& bsdf, const glm::vec3& wo, int n, uint64_t seed) {
   Rng rng(seed);
