@@ -60,29 +60,42 @@ Bsdf::Outgoing Bsdf::outgoingTerms(const glm::vec3& woWorld) const {
   return o;
 }
 
+namespace {
+
+// wo + wi normalised into h; false where they are opposite.
+bool halfVector(const glm::vec3& wo, const glm::vec3& wi, glm::vec3& h) {
+  h = wo + wi;
+  const float len = glm::length(h);
+  if (!(len > 1e-8f)) return false;
+  h /= len;
+  return true;
+}
+
+// The visible normals' density reflected (wi given wo): G1(wo) D(h) / (4 wo.z).
+float reflectedVisibleNormalPdf(float lambdaOut, float d, float cosOut) {
+  return (1.0f / (1.0f + lambdaOut)) * d / (4.0f * cosOut);
+}
+
+}  // namespace
+
+glm::vec3 Bsdf::coupledDiffuse(const glm::vec3& albedoOut, const glm::vec3& albedoIn, float cosIn) const {
+  return hasSpecular() ? diffuseScale_ * (glm::vec3(1.0f) - albedoOut) * (glm::vec3(1.0f) - albedoIn) * cosIn
+                       : diffuseScale_ * cosIn;
+}
+
+// F D G2 / (4 cos_o cos_i), times cos_i; G2 is height-correlated Smith, 1 / (1 + Lambda_o + Lambda_i).
+glm::vec3 Bsdf::microfacetF(const glm::vec3& wo, const glm::vec3& h, float d, float lambdaOut, float lambdaIn) const {
+  const float g2 = 1.0f / (1.0f + lambdaOut + lambdaIn);
+  return ggx::schlick(params_.f0, params_.f90, glm::dot(wo, h)) * (d * g2 / (4.0f * wo.z));
+}
+
 glm::vec3 Bsdf::evalLocal(const Outgoing& o, const glm::vec3& wi) const {
   const glm::vec3& wo = o.local;
   if (wo.z <= 0.0f || wi.z <= 0.0f) return glm::vec3(0.0f);
   glm::vec3 f(0.0f);
-  if (!isBlack(diffuseScale_)) {
-    if (hasSpecular()) {
-      const AlbedoTerms ti = vpl::specularAlbedo(wi.z, params_.alpha);
-      const glm::vec3 ei = glm::clamp(params_.f0 * ti.a + params_.f90 * ti.b, glm::vec3(0.0f), glm::vec3(1.0f));
-      f += diffuseScale_ * (glm::vec3(1.0f) - o.albedo) * (glm::vec3(1.0f) - ei) * wi.z;
-    } else {
-      f += diffuseScale_ * wi.z;
-    }
-  }
-  if (hasSpecular()) {
-    glm::vec3 h = wo + wi;
-    const float len = glm::length(h);
-    if (len > 1e-8f) {
-      h /= len;
-      // F D G2 / (4 cos_o cos_i), times cos_i; G2 is height-correlated Smith, 1 / (1 + Lambda_o + Lambda_i).
-      const float g2 = 1.0f / (1.0f + o.lambda + ggx::lambda(wi, params_.alpha));
-      f += ggx::schlick(params_.f0, params_.f90, glm::dot(wo, h)) * (ggx::D(h, params_.alpha) * g2 / (4.0f * wo.z));
-    }
-  }
+  if (!isBlack(diffuseScale_)) f += coupledDiffuse(o.albedo, specularAlbedo(wi.z), wi.z);
+  if (glm::vec3 h; hasSpecular() && halfVector(wo, wi, h))
+    f += microfacetF(wo, h, ggx::D(h, params_.alpha), o.lambda, ggx::lambda(wi, params_.alpha));
   return f;
 }
 
@@ -91,12 +104,8 @@ float Bsdf::pdfLocal(const Outgoing& o, const glm::vec3& wi) const {
   if (wo.z <= 0.0f || wi.z <= 0.0f) return 0.0f;
   const float pSpec = o.specularProbability;
   float pdf = (1.0f - pSpec) * cosineHemispherePdf(wi.z);
-  if (pSpec > 0.0f) {
-    glm::vec3 h = wo + wi;
-    const float len = glm::length(h);
-    // The visible normals' density reflected: G1(wo) D(h) / (4 wo.z).
-    if (len > 1e-8f) pdf += pSpec * ((1.0f / (1.0f + o.lambda)) * ggx::D(h / len, params_.alpha) / (4.0f * wo.z));
-  }
+  if (glm::vec3 h; pSpec > 0.0f && halfVector(wo, wi, h))
+    pdf += pSpec * reflectedVisibleNormalPdf(o.lambda, ggx::D(h, params_.alpha), wo.z);
   return pdf;
 }
 
@@ -142,23 +151,15 @@ Bsdf::Evaluation Bsdf::evalPdfLocal(const Outgoing& o, const glm::vec3& wi) cons
     specularIn = specularProbability(albedoIn);
   }
   Evaluation e;
-  if (!isBlack(diffuseScale_))
-    e.f += hasSpecular() ? diffuseScale_ * (glm::vec3(1.0f) - o.albedo) * (glm::vec3(1.0f) - albedoIn) * wi.z
-                         : diffuseScale_ * wi.z;
+  if (!isBlack(diffuseScale_)) e.f += coupledDiffuse(o.albedo, albedoIn, wi.z);
   e.pdf = (1.0f - o.specularProbability) * cosineHemispherePdf(wi.z);
   e.pdfReverse = (1.0f - specularIn) * cosineHemispherePdf(wo.z);
-  if (hasSpecular()) {
-    glm::vec3 h = wo + wi;
-    const float len = glm::length(h);
-    if (len > 1e-8f) {
-      h /= len;
+  if (glm::vec3 h; hasSpecular() && halfVector(wo, wi, h)) {
       const float d = ggx::D(h, params_.alpha);
-      const float g2 = 1.0f / (1.0f + o.lambda + lambdaIn);
-      e.f += ggx::schlick(params_.f0, params_.f90, glm::dot(wo, h)) * (d * g2 / (4.0f * wo.z));
-      if (o.specularProbability > 0.0f) e.pdf += o.specularProbability * ((1.0f / (1.0f + o.lambda)) * d / (4.0f * wo.z));
-      if (specularIn > 0.0f) e.pdfReverse += specularIn * ((1.0f / (1.0f + lambdaIn)) * d / (4.0f * wi.z));
+      e.f += microfacetF(wo, h, d, o.lambda, lambdaIn);
+      if (o.specularProbability > 0.0f) e.pdf += o.specularProbability * reflectedVisibleNormalPdf(o.lambda, d, wo.z);
+      if (specularIn > 0.0f) e.pdfReverse += specularIn * reflectedVisibleNormalPdf(lambdaIn, d, wi.z);
     }
-  }
   return e;
 }
 
