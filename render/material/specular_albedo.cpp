@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 #include "render/material/ggx.h"
 
 namespace vpl {
@@ -45,30 +43,28 @@ AlbedoTerms integrate(float mu, float alpha) {
   return {float(a / n), float(b / n)};
 }
 
-// A million samples of the visible normals, 0.06 s on one core: the rows are independent, so they
-// are integrated in parallel (a glossy scene's first image waits for them). Isolated: a thread that
-// waits for its rows must not pick up a render task meanwhile, which could ask for this table while
-// it is being built.
 Table buildTable() {
   Table t;
-  tbb::this_task_arena::isolate([&] {
-    tbb::parallel_for(0, kAlpha, [&](int j) {
-      for (int i = 0; i < kMu; ++i) t.e[j * kMu + i] = integrate(muOfColumn(i), alphaOfRow(j));
+  {
+    for (int j = 0; j < kAlpha; ++j) {
+      double avgA = 0.0, avgB = 0.0;
+      for (int i = 0; i < kMu; ++i) {
+        t.e[j * kMu + i] = integrate(muOfColumn(i), alphaOfRow(j));
+      }
       // 2 * integral E(mu) mu dmu by the trapezoid rule on the table's own columns, so the
       // coupling's normaliser matches the interpolated E it is used with.
-      double avgA = 0.0, avgB = 0.0;
       for (int i = 0; i + 1 < kMu; ++i) {
         const float m0 = float(i) / (kMu - 1), m1 = float(i + 1) / (kMu - 1);
         avgA += 0.5 * (t.e[j * kMu + i].a * m0 + t.e[j * kMu + i + 1].a * m1) * (m1 - m0);
         avgB += 0.5 * (t.e[j * kMu + i].b * m0 + t.e[j * kMu + i + 1].b * m1) * (m1 - m0);
       }
       t.average[j] = {float(2.0 * avgA), float(2.0 * avgB)};
-    });
-  });
+    }
+  }
   return t;
 }
 
-// Built on first use; a function-local static is thread-safe and cheap to check.
+// Built on first use (a few milliseconds); a function-local static is thread-safe and cheap to check.
 const Table& table() {
   static const Table t = buildTable();
   return t;
