@@ -71,11 +71,6 @@ bool halfVector(const glm::vec3& wo, const glm::vec3& wi, glm::vec3& h) {
   return true;
 }
 
-// The visible normals' density reflected (wi given wo): G1(wo) D(h) / (4 wo.z).
-float reflectedVisibleNormalPdf(float lambdaOut, float d, float cosOut) {
-  return (1.0f / (1.0f + lambdaOut)) * d / (4.0f * cosOut);
-}
-
 }  // namespace
 
 glm::vec3 Bsdf::coupledDiffuse(const glm::vec3& albedoOut, const glm::vec3& albedoIn, float cosIn) const {
@@ -105,7 +100,7 @@ float Bsdf::pdfLocal(const Outgoing& o, const glm::vec3& wi) const {
   const float pSpec = o.specularProbability;
   float pdf = (1.0f - pSpec) * cosineHemispherePdf(wi.z);
   if (glm::vec3 h; pSpec > 0.0f && halfVector(wo, wi, h))
-    pdf += pSpec * reflectedVisibleNormalPdf(o.lambda, ggx::D(h, params_.alpha), wo.z);
+    pdf += pSpec * ggx::reflectionPdf(o.lambda, ggx::D(h, params_.alpha), wo.z);
   return pdf;
 }
 
@@ -157,8 +152,8 @@ Bsdf::Evaluation Bsdf::evalPdfLocal(const Outgoing& o, const glm::vec3& wi) cons
   if (glm::vec3 h; hasSpecular() && halfVector(wo, wi, h)) {
       const float d = ggx::D(h, params_.alpha);
       e.f += microfacetF(wo, h, d, o.lambda, lambdaIn);
-      if (o.specularProbability > 0.0f) e.pdf += o.specularProbability * reflectedVisibleNormalPdf(o.lambda, d, wo.z);
-      if (specularIn > 0.0f) e.pdfReverse += specularIn * reflectedVisibleNormalPdf(lambdaIn, d, wi.z);
+      if (o.specularProbability > 0.0f) e.pdf += o.specularProbability * ggx::reflectionPdf(o.lambda, d, wo.z);
+      if (specularIn > 0.0f) e.pdfReverse += specularIn * ggx::reflectionPdf(lambdaIn, d, wi.z);
     }
   return e;
 }

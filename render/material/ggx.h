@@ -44,9 +44,10 @@ inline glm::vec3 sampleVisibleNormal(const glm::vec3& wo, glm::vec2 u, float alp
   return glm::normalize(glm::vec3(alpha * nh.x, alpha * nh.y, std::max(1e-7f, nh.z)));
 }
 
-// Density of wi = reflect(wo, h) when h is a visible normal of wo: D_wo(h) / (4 wo.h).
-inline float reflectionPdf(const glm::vec3& wo, const glm::vec3& h, float alpha) {
-  return G1(wo, alpha) * D(h, alpha) / (4.0f * wo.z);
+// Density of wi = reflect(wo, h) when h is a visible normal of wo: D_wo(h) / (4 wo.h) = G1(wo) D(h) / (4 wo.z),
+// from wo's Smith Lambda, D(h) and wo.z, which the BSDF has in hand.
+inline float reflectionPdf(float lambdaOut, float d, float cosOut) {
+  return 1.0f / (1.0f + lambdaOut) * d / (4.0f * cosOut);
 }
 
 // Schlick's Fresnel with an explicit grazing value f90 (1 for the classic form).
