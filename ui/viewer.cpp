@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <memory>
 #include <stdexcept>
+#include <string>
 #define GLFW_INCLUDE_NONE  // the display loads its own GL entry points (ui/gl_api.h)
 #include <GLFW/glfw3.h>
 #include <imgui.h>
@@ -312,8 +313,17 @@ int runViewer(const ViewerOptions& options) {
             writePngBytes(path, fbWidth, fbHeight, display.readPixels(fbWidth, fbHeight));
           }, message);
         ImGui::SameLine();
-        if (ImGui::Button("save EXR") && image.width > 0)
-          save("vplview_image.exr", [&](const std::string& path) { writeExr(path, image); }, message);
+        // The estimate, not the display's fade over the preview: an EXR is data, read back as radiance.
+        if (ImGui::Button("save EXR")) {
+          const ProgressiveSession::Estimate estimate = session->latestEstimate();
+          if (estimate.image.width > 0 &&
+              save("vplview_image.exr", [&](const std::string& path) { writeExr(path, estimate.image); }, message)) {
+            const bool film = estimate.stage == SessionStage::Refine ||
+                              (estimate.stage == SessionStage::Done && stats.mode != SamplingMode::Preview);
+            message += std::string(" (") + modeName(stats.mode) + ", " + stageName(estimate.stage) + ", " +
+                       std::to_string(estimate.spp) + (film ? " spp)" : estimate.spp == 1 ? " pass)" : " passes)");
+          }
+        }
         if (!message.empty()) ImGui::TextUnformatted(message.c_str());
         ImGui::End();
       }

@@ -137,6 +137,11 @@ bool ProgressiveSession::latestImage(Image& out, uint64_t& version, Image* varia
   return true;
 }
 
+ProgressiveSession::Estimate ProgressiveSession::latestEstimate() const {
+  std::lock_guard lock(mutex_);
+  return {estimate_.width > 0 ? estimate_ : shown_, stats_.stage, stats_.spp};
+}
+
 SessionStats ProgressiveSession::stats() const {
   std::lock_guard lock(mutex_);
   return stats_;
@@ -152,10 +157,11 @@ bool ProgressiveSession::waitUntilDone(double seconds) const {
   return changed_.wait_for(lock, std::chrono::duration<double>(seconds), [this] { return idle_ && !pending_; });
 }
 
-void ProgressiveSession::publish(const Image& image, SessionStage stage, int spp, Image variance) {
+void ProgressiveSession::publish(const Image& image, SessionStage stage, int spp, Image variance, Image estimate) {
   std::lock_guard lock(mutex_);
   shown_ = image;
   shownVariance_ = std::move(variance);
+  estimate_ = std::move(estimate);
   ++version_;
   stats_.stage = stage;
   stats_.spp = spp;
@@ -383,9 +389,10 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
   // to reach 16 spp, all of it behind a still preview), and no frame steps back to much more noise.
   const Image previewShown = preview.complete > 0 ? preview.film->resolve() : Image();
   const auto publishFilm = [&] {
-    const Image film = mine.film->resolve();
+    Image film = mine.film->resolve();
     const float share = previewShown.pixels.empty() ? 1.0f : float(mine.complete) / float(settings_.handoverSpp);
-    publish(crossfade(previewShown, film, share), SessionStage::Refine, mine.complete, mine.film->resolveVariance());
+    const Image shown = crossfade(previewShown, film, share);
+    publish(shown, SessionStage::Refine, mine.complete, mine.film->resolveVariance(), share < 1.0f ? std::move(film) : Image());
   };
   // A mode flipped back to shows its own film at once.
   if (mine.complete > 0) publishFilm();

@@ -97,6 +97,15 @@ class ProgressiveSession {
   // `variance`, when given, gets the per-pixel relative variance of the path-traced estimate (its
   // error, DESIGN.md §4, as the samples themselves predict it); zeros while the preview is shown.
   bool latestImage(Image& out, uint64_t& version, Image* variance = nullptr) const;
+  // What the shown stage has estimated, without the display's fade: once a refining pass is in, the
+  // path-traced film alone (the image the samples converge to), before it the quick pass or the
+  // preview. "save EXR" writes this; a screenshot, what the window shows.
+  struct Estimate {
+    Image image;
+    SessionStage stage = SessionStage::Quick;
+    int spp = 0;
+  };
+  Estimate latestEstimate() const;
   SessionStats stats() const;
   const SessionSettings& settings() const { return settings_; }
   CameraData camera() const;
@@ -110,7 +119,8 @@ class ProgressiveSession {
   void requestRestart();  // with mutex_ held: post the current camera, mode and size, cancel the pass
   void controllerLoop();
   void runUntilChanged(CameraState& state, const Request& request);
-  void publish(const Image& image, SessionStage stage, int spp, Image variance = {});
+  // `estimate`: the stage's own image when `image` is a display mix (the fade); empty: `image` is it.
+  void publish(const Image& image, SessionStage stage, int spp, Image variance = {}, Image estimate = {});
   bool cancelled() const { return cancel_.load(std::memory_order_relaxed); }
 
   std::shared_ptr<const RenderScene> scene_;
@@ -126,7 +136,7 @@ class ProgressiveSession {
   mutable std::condition_variable changed_;
   std::unique_ptr<Request> pending_;
   bool quit_ = false, idle_ = false;
-  Image shown_, shownVariance_;
+  Image shown_, shownVariance_, estimate_;
   uint64_t version_ = 0;
   SessionStats stats_;
   CameraData camera_;

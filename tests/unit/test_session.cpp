@@ -232,6 +232,15 @@ TEST(Session, TheFilmFadesInOverThePreviewBeforeTheHandover) {
     previewMean += double(preview.x + preview.y + preview.z) / double(film.pixels.size());
   }
   EXPECT_GT(previewMean, 0.0);
+  // What "save EXR" writes is the film alone, bit for bit, not the mix on screen.
+  const ProgressiveSession::Estimate estimate = fading.latestEstimate();
+  EXPECT_EQ(estimate.stage, SessionStage::Done);  // maxSpp reached
+  EXPECT_EQ(estimate.spp, 3);
+  ASSERT_EQ(estimate.image.pixels.size(), film.pixels.size());
+  for (size_t i = 0; i < film.pixels.size(); ++i) ASSERT_EQ(estimate.image.pixels[i], film.pixels[i]) << "pixel " << i;
+  const ProgressiveSession::Estimate handedOver = filmOnly.latestEstimate();
+  ASSERT_EQ(handedOver.image.pixels.size(), film.pixels.size());
+  for (size_t i = 0; i < film.pixels.size(); ++i) ASSERT_EQ(handedOver.image.pixels[i], film.pixels[i]) << "pixel " << i;
 }
 
 TEST(Session, ShowsAFullFrameFirstAndNeverANonFiniteOne) {
