@@ -1,5 +1,5 @@
 // Directional albedo of the GGX lobe with Schlick Fresnel, E(mu) = f0 A(mu, alpha) + f90 B(mu, alpha),
-// tabulated once (Kelemen & Szirmay-Kalos 2001 couple the diffuse lobe to 1 - E).
+// tabulated (specular_albedo_integral.h; Kelemen & Szirmay-Kalos 2001 couple the diffuse lobe to 1 - E).
 #pragma once
 #include <glm/glm.hpp>
 

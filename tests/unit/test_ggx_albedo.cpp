@@ -24,6 +24,7 @@
 #include <functional>
 #include <vector>
 #include "render/material/bsdf.h"
+#include "render/material/specular_albedo_integral.h"
 #include "render/sampling/rng.h"
 #include "render/session/render_job.h"
 #include "tests/unit/support.h"
@@ -248,6 +249,23 @@ TEST(GgxAlbedo, CoupledDielectricTotalAlbedoMatchesClosedForm) {
         EXPECT_NEAR(mc.mean.y, expected, 5e-3 + kSigmas * mc.error.y + es.error)
             << "rho " << rho << " roughness " << roughness << " mu " << mu;
       }
+}
+
+// The renderer reads the table embedded in specular_albedo_values.inc, not the integral (which every
+// process used to compute at start); the two must be the same floats. Without -ffast-math or FMA
+// contraction the integral's float operations are the same in every build, so this asks for bits.
+TEST(GgxAlbedo, EmbeddedTableIsTheIntegralBitForBit) {
+  const SpecularAlbedoTable integral = integrateSpecularAlbedoTable();
+  const SpecularAlbedoTable& embedded = embeddedSpecularAlbedoTable();
+  const char* regenerate = "regenerate: build/tools/make_specular_albedo_table > render/material/specular_albedo_values.inc";
+  for (size_t k = 0; k < integral.e.size(); ++k) {
+    ASSERT_EQ(embedded.e[k].a, integral.e[k].a) << "entry " << k << "; " << regenerate;
+    ASSERT_EQ(embedded.e[k].b, integral.e[k].b) << "entry " << k << "; " << regenerate;
+  }
+  for (size_t j = 0; j < integral.average.size(); ++j) {
+    ASSERT_EQ(embedded.average[j].a, integral.average[j].a) << "row " << j << "; " << regenerate;
+    ASSERT_EQ(embedded.average[j].b, integral.average[j].b) << "row " << j << "; " << regenerate;
+  }
 }
 
 // ---- (c) Through the whole pipeline: a metal plane under a uniform white sky -----------------------
