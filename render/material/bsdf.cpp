@@ -150,11 +150,11 @@ Bsdf::Evaluation Bsdf::evalPdfLocal(const Outgoing& o, const glm::vec3& wi) cons
   e.pdf = (1.0f - o.specularProbability) * cosineHemispherePdf(wi.z);
   e.pdfReverse = (1.0f - specularIn) * cosineHemispherePdf(wo.z);
   if (glm::vec3 h; hasSpecular() && halfVector(wo, wi, h)) {
-      const float d = ggx::D(h, params_.alpha);
-      e.f += microfacetF(wo, h, d, o.lambda, lambdaIn);
-      if (o.specularProbability > 0.0f) e.pdf += o.specularProbability * ggx::reflectionPdf(o.lambda, d, wo.z);
-      if (specularIn > 0.0f) e.pdfReverse += specularIn * ggx::reflectionPdf(lambdaIn, d, wi.z);
-    }
+    const float d = ggx::D(h, params_.alpha);
+    e.f += microfacetF(wo, h, d, o.lambda, lambdaIn);
+    if (o.specularProbability > 0.0f) e.pdf += o.specularProbability * ggx::reflectionPdf(o.lambda, d, wo.z);
+    if (specularIn > 0.0f) e.pdfReverse += specularIn * ggx::reflectionPdf(lambdaIn, d, wi.z);
+  }
   return e;
 }
 
