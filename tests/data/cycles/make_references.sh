@@ -6,10 +6,9 @@
 # counts path segments from the camera). The test averages the 8 and takes Cycles' own standard
 # error from their spread. Refused (exit 2, no exact counterpart): cornell_glossy (dielectric
 # glossy layers, metallic 0 with specularFactor 1) and the generated interior (the same).
-# door_ajar maps but is not used (see the test's header).
 # Usage, from the repository root: tests/data/cycles/make_references.sh [BUILD_DIR] [SCENE...]
 # (default: build, every scene below; BUILD_DIR holds the generated scenes/skylit_hall.glb and
-# lamp_rooms.glb). 1-2 min for cornell_box, about 6 for two_rooms, 5 for skylit_hall and 2 for lamp_rooms, on 2 idle cores; needs
+# lamp_rooms.glb). 1-2 min for cornell_box, about 6 for two_rooms, 5 for skylit_hall, 2 for lamp_rooms and 2 for door_ajar, on 2 idle cores; needs
 # `apt-get install blender python3-numpy`.
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/../../.." && pwd)
@@ -18,7 +17,7 @@ shift || true
 tool=$repo/../shared/tools/cycles/cycles-render
 out=$repo/tests/data/cycles
 . "$repo/bench/lib.sh"
-for scene in ${*:-cornell_box two_rooms skylit_hall lamp_rooms}; do
+for scene in ${*:-cornell_box two_rooms skylit_hall lamp_rooms door_ajar}; do
   file=$(scene_file "$repo" "$build" "$scene" make_references)
   for seed in 1 2 3 4 5 6 7 8; do
     "$tool" "$file" "$out/${scene}_seed$seed.exr" \
