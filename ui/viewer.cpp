@@ -252,13 +252,17 @@ int runViewer(const ViewerOptions& options) {
                     static_cast<unsigned long long>(stats.discarded), stats.rouletteWindow ? "VPL window" : settings.tracer.roulette == RouletteRule::Throughput ? "throughput" : "sqrt");
         if (stats.mode == SamplingMode::Mis && stats.learnedBsdfProbability >= 0.0)
           ImGui::Text("MIS BSDF probability: %.2f (mean learned over cache points)", stats.learnedBsdfProbability);
-        if (stats.mode == SamplingMode::Mis && stats.guideSwitchPass > 0)
+        if (stats.mode == SamplingMode::Mis && stats.guideSwitchAdopted)
+          ImGui::Text("guide: BSDF samples in lanes from the first pass (an earlier view's forecast gain %.2f)", stats.guideGain);
+        else if (stats.mode == SamplingMode::Mis && stats.guideSwitchPass > 0)
           ImGui::Text("guide: forecast gain %.2f, BSDF samples in lanes from pass %d", stats.guideGain, stats.guideSwitchPass);
         else if (stats.mode == SamplingMode::Mis && stats.guideGain >= 0.0)
           ImGui::Text("guide: forecast gain %.2f, kept", stats.guideGain);
         if (stats.joinDepth != SessionStats::kNoJoins)
           ImGui::Text("joins: %s%s", stats.joinDepth < 0 ? "from every vertex" : ("up to depth " + std::to_string(stats.joinDepth)).c_str(),
-                      stats.joinDepthTrial ? (stats.joinDepthDecided ? " (auto: measured best)" : " (auto: trying the depths)") : "");
+                      stats.joinDepthTrial    ? (stats.joinDepthDecided ? " (auto: measured best)" : " (auto: trying the depths)")
+                      : stats.joinDepthAdopted ? " (auto: measured best in an earlier view)"
+                                               : "");
         if (stats.learnedLightRegions >= 0.0)
           ImGui::Text("light samples: %.0f %% of the regions learned which lights they see", 100.0 * stats.learnedLightRegions);
         if (isGuided(stats.mode) && stats.learnedGuideShare >= 0.0)

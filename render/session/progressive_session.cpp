@@ -69,6 +69,8 @@ struct ProgressiveSession::CameraState {
     std::unique_ptr<EmitterGuide> lights;       // learned next-event estimation, from this film's passes
     std::unique_ptr<JoinDepthTrial> joinTrial;  // --join-depth auto: which depth this film's passes join to
     GuideSwitch guideSwitch;                    // mis: whether BSDF samples in lanes took over this film
+    bool joinDepthAdopted = false;              // joins to the depth an earlier view's trial chose
+    double variance = -1.0;  // relative variance per sample after SceneDecisions::kVariancePass passes
   };
   std::optional<Request> key;
   Clock::time_point restart = Clock::now();
@@ -199,6 +201,7 @@ void ProgressiveSession::controllerLoop() {
       stats_.learnedGuideShare = -1.0;
       stats_.guideSwitchPass = 0;
       stats_.guideGain = -1.0;
+      stats_.guideSwitchAdopted = stats_.joinDepthAdopted = false;
     }
     state.key = request;
     arena.execute([&] { runUntilChanged(state, request); });
@@ -316,8 +319,17 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
   }
   if (request.mode == SamplingMode::Preview) return;
 
-  // 3. Refine: the guide for guided modes, then path-traced passes into this mode's film.
-  if (isGuided(request.mode) && !state.guide) {
+  // 3. Refine: the guide for guided modes, then path-traced passes into the mode's own film.
+  CameraState::ModeFilm& mine = state.films[request.mode];
+  SceneDecisions unkept, &decided = settings_.keepSceneDecisions ? decisions_[request.mode] : unkept;
+  if (!mine.film) {
+    mine.film = std::make_unique<Film>(w, h);
+    if (request.mode == SamplingMode::Mis && settings_.guide.switchToLanes && decided.lanesForMis)
+      mine.guideSwitch.adopt(decided.guideGain);
+  }
+  // mis once BSDF samples in lanes have taken over needs no guide.
+  const bool guided = isGuided(request.mode) && !mine.guideSwitch.on();
+  if (guided && !state.guide) {
     const auto t = Clock::now();
     state.guide = std::make_unique<GuideField>(buildGuideField(scene, *state.field, settings_.guide));
     std::lock_guard lock(mutex_);
@@ -325,10 +337,8 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
     stats_.cachePoints = state.guide->size();
   }
   if (cancelled()) return;
-  CameraState::ModeFilm& mine = state.films[request.mode];
-  if (!mine.film) mine.film = std::make_unique<Film>(w, h);
   ContinuationFactory continuation;
-  if (isGuided(request.mode)) {
+  if (guided) {
     const GuideField& guide = *state.guide;
     const SamplingMode mode = request.mode;
     if (!mine.learners)
@@ -345,7 +355,20 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
   }
   if (joinPaths > 0 && !mine.joins) {
     mine.joins = std::make_unique<LightVertexCache>(settings_.connections);
-    if (settings_.connections.joinDepth == ConnectionSettings::kJoinDepthAuto) mine.joinTrial = std::make_unique<JoinDepthTrial>(w, h);
+    // A kept depth 1 waits for this view's variance (after kVariancePass) before the trial would start;
+    // until then the joins are from every vertex, as in the trial's first passes.
+    if (settings_.connections.joinDepth == ConnectionSettings::kJoinDepthAuto) {
+      if (decided.keepsJoinDepth(-1.0)) {
+        mine.joinDepthAdopted = true;
+        mine.joins->setJoinDepth(decided.joinDepth);
+      } else if (decided.joinDepth == SceneDecisions::kUndecided)
+        mine.joinTrial = std::make_unique<JoinDepthTrial>(w, h);
+    }
+  }
+  {
+    std::lock_guard lock(mutex_);
+    stats_.guideSwitchAdopted = mine.guideSwitch.adopted();
+    if (mine.guideSwitch.adopted()) stats_.guideGain = mine.guideSwitch.gain();
   }
   if (settings_.tracer.learnLights && !mine.lights) mine.lights = std::make_unique<EmitterGuide>(scene, true);
   const EmitterGuide* lights = mine.lights && mine.lights->active() ? mine.lights.get() : nullptr;
@@ -412,12 +435,31 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
     const JoinDepthTrial::PassTargets target = mine.joinTrial ? mine.joinTrial->beginPass(slot, *mine.film, *mine.joins)
                                                              : JoinDepthTrial::PassTargets{*mine.film};
     const PassStats pass = renderer->renderPass(target.film, index, &cancel_, target.counterfactual, target.counterfactualDepth);
-    if (mine.joinTrial) mine.joinTrial->endPass(slot, *mine.film, !cancelled(), pass, *mine.joins);
+    if (mine.joinTrial) {
+      mine.joinTrial->endPass(slot, *mine.film, !cancelled(), pass, *mine.joins);
+      if (mine.joinTrial->decided()) {
+        decided.joinDepth = mine.joinTrial->chosen();
+        decided.joinDepthVariance = mine.variance;
+      }
+    }
+    if (mine.joins && settings_.connections.joinDepth == ConnectionSettings::kJoinDepthAuto && !cancelled() &&
+        mine.complete + 1 == int(SceneDecisions::kVariancePass)) {
+      mine.variance = mine.film->sampleRelativeVariance();
+      if (!mine.joinTrial && !mine.joinDepthAdopted) {
+        if (decided.keepsJoinDepth(mine.variance)) {
+          mine.joinDepthAdopted = true;
+          mine.joins->setJoinDepth(decided.joinDepth);
+        } else {
+          mine.joinTrial = std::make_unique<JoinDepthTrial>(w, h);
+        }
+      }
+    }
     if (mine.joins) {
       std::lock_guard lock(mutex_);
       stats_.joinDepth = mine.joins->joinDepth();
       stats_.joinDepthTrial = mine.joinTrial != nullptr;
       stats_.joinDepthDecided = mine.joinTrial && mine.joinTrial->decided();
+      stats_.joinDepthAdopted = mine.joinDepthAdopted;
     }
     state.renderSeconds += secondsSince(t);
     state.samples += pass.samples;
@@ -438,8 +480,11 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
       mine.learners->update();
       if (request.mode == SamplingMode::Mis && settings_.guide.switchToLanes && !mine.guideSwitch.decided() &&
           mine.guideSwitch.update(uint64_t(mine.complete), mine.learners->guideGain(),
-                                  settings_.stratifiedSampler && PathLanes::unsupported(refineTracer()).empty()))
+                                  settings_.stratifiedSampler && PathLanes::unsupported(refineTracer()).empty())) {
+        decided.lanesForMis = true;
+        decided.guideGain = mine.guideSwitch.gain();
         emplaceRenderer();
+      }
       std::lock_guard lock(mutex_);
       stats_.learnedBsdfProbability = mine.learners->meanBsdfProbability();
       stats_.learnedGuideShare = mine.learners->meanGuideShare();

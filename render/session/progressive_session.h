@@ -8,14 +8,13 @@
 //                `previewPasses` and `previewSeconds`, with fewer clusters per pixel)
 //   3. refine    the guide (guided modes), then path-traced passes into the mode's own film, until
 //                `maxSpp`
-// The shown image is the newest stage with something to show; the path-traced film fades in over the
-// preview from its first pass and has taken over at `handoverSpp` samples, so the picture is never
-// black, never steps back to much more noise and never waits behind a still preview. Films are kept
-// per mode while the camera stays, so flipping back to a mode shows its image at once.
+// What a view's first passes measure about the scene rather than the view (SceneDecisions) is kept
+// across camera moves, so that a later view need not spend its first passes on it again.
 #pragma once
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -28,6 +27,7 @@
 #include "render/integrator/sampling_mode.h"
 #include "render/scene/camera.h"
 #include "render/scene/render_scene.h"
+#include "render/session/scene_decisions.h"
 #include "render/vpl/irradiance_grid.h"
 #include "render/vpl/vpl_preview.h"
 
@@ -44,6 +44,9 @@ struct SessionSettings {
   int maxSpp = 1 << 16;      // the controller idles after this many path-traced samples
   int maxSlices = 384;       // slices (cache points) per view at most; 0: preview.slices alone decides
   bool coarsePreview = true;  // show a coarse preview pass before the full clustering
+  // Keep what a view's passes decided about the scene across camera moves (SceneDecisions); false: every view
+  // measures again, as a fresh session would (the ablation of bench/refine_after_move).
+  bool keepSceneDecisions = true;
   // The camera paths' numbers: stratified (Owen-scrambled Sobol'), or independent random in every
   // pass, quick, preview and refining alike (`--sampler random`, an ablation; RenderJobSettings's).
   bool stratifiedSampler = true;
@@ -74,11 +77,13 @@ struct SessionStats {
   int guideSwitchPass = 0;   // mis: the pass from which BSDF samples in lanes took over (0: not, or not yet)
   int lanes = 1;             // paths the refinement traces at once (PathLanes::kLanes where the lanes apply)
   double guideGain = -1.0;   // mis: the forecast that decided it (GuideSwitch), -1 until decided
+  bool guideSwitchAdopted = false;  // mis: BSDF samples in lanes from the first pass, as an earlier view decided
   double learnedGuideShare = -1.0;       // learned guides: mean weight of the learned part against the prior (-1: off)
   double learnedLightRegions = -1.0;     // learned next-event estimation: the share of regions that learned (-1: off)
   static constexpr int kNoJoins = -100;
   int joinDepth = kNoJoins;               // VPL connections: the depth the last pass joined to (-1: every vertex)
   bool joinDepthTrial = false, joinDepthDecided = false;  // --join-depth auto: trying, or decided
+  bool joinDepthAdopted = false;  // --join-depth auto: the depth an earlier view's trial chose, without a trial
 };
 
 class ProgressiveSession {
@@ -131,6 +136,8 @@ class ProgressiveSession {
   // first uses the rule (at once with --roulette vpl, on the film's variance with auto).
   std::unique_ptr<IrradianceGrid> irradiance_;
   std::unique_ptr<PathTracer> windowTracer_;
+  // Per mode, what an earlier view decided about the scene; only the controller touches it.
+  std::map<SamplingMode, SceneDecisions> decisions_;
 
   mutable std::mutex mutex_;  // guards everything below up to the thread
   mutable std::condition_variable changed_;

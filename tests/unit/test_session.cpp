@@ -108,8 +108,8 @@ TEST(Session, RandomSamplerReachesTheRefiningAndThePreviewPasses) {
 
 // mis's switch to BSDF samples in lanes in the viewer (GuideSwitch): on the Cornell box, where the
 // guide takes little off, the film's passes after the trial go to the lanes and the panel says so; with
-// --guide-switch off it keeps the guide; a camera move restarts the decision.
-TEST(Session, MisSwitchesToLanesAfterTheTrialAndARestartDecidesAgain) {
+// --guide-switch off it keeps the guide; a camera move keeps the decision (the next test).
+TEST(Session, MisSwitchesToLanesAfterTheTrialAndKeepsItAcrossACameraMove) {
   __builtin_cpu_init();
   const bool lanes = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
   const auto scene = cornell();
@@ -125,12 +125,95 @@ TEST(Session, MisSwitchesToLanesAfterTheTrialAndARestartDecidesAgain) {
   EXPECT_EQ(stats.lanes, lanes ? PathLanes::kLanes : 1);
   session.setCamera(moved(defaultCamera(scene->data())));
   finalImage(session);
-  EXPECT_EQ(session.stats().guideSwitchPass, lanes ? int(GuideSwitch::kDecisionPass) : 0);
+  EXPECT_EQ(session.stats().guideSwitchPass, 0);
+  EXPECT_EQ(session.stats().guideSwitchAdopted, lanes);
+  EXPECT_EQ(session.stats().lanes, lanes ? PathLanes::kLanes : 1);
   settings.guide.switchToLanes = false;
   ProgressiveSession guided(scene, defaultCamera(scene->data()), settings);
   finalImage(guided);
   EXPECT_EQ(guided.stats().guideSwitchPass, 0);
   EXPECT_EQ(guided.stats().lanes, 1);
+}
+
+// What the first view's passes decided about the scene is kept across a camera move: on door_ajar,
+// mis's guide switch (BSDF samples in lanes) and the trial's choice of every vertex's joins. The new
+// view then renders from its first pass exactly what a brdf session with the same joins renders: the
+// same unbiased estimator, bit for bit, with no guide built and no trial passes.
+TEST(Session, ACameraMoveKeepsWhatTheScenesPassesDecided) {
+  __builtin_cpu_init();
+  if (!__builtin_cpu_supports("avx2") || !__builtin_cpu_supports("fma")) GTEST_SKIP() << "no AVX2 and FMA: no lanes";
+  const auto scene = std::make_shared<const RenderScene>(loadGltf(test::sourceDir() + "/scenes/door_ajar.gltf"));
+  const CameraData start = defaultCamera(scene->data());
+  SessionSettings settings = small(SamplingMode::Mis, int(GuideSwitch::kDecisionPass) + 2);
+  settings.width = 96;
+  settings.height = 72;
+  ProgressiveSession session(scene, start, settings);
+  finalImage(session);
+  SessionStats stats = session.stats();
+  ASSERT_EQ(stats.guideSwitchPass, int(GuideSwitch::kDecisionPass)) << "door_ajar's guide gain " << stats.guideGain;
+  ASSERT_TRUE(stats.joinDepthDecided);
+  ASSERT_EQ(stats.joinDepth, -1) << "door_ajar's trial chose every vertex before";
+  EXPECT_FALSE(stats.guideSwitchAdopted);
+  EXPECT_FALSE(stats.joinDepthAdopted);
+  const double gain = stats.guideGain;
+
+  session.setCamera(moved(start));
+  const Image after = finalImage(session);
+  stats = session.stats();
+  EXPECT_TRUE(stats.guideSwitchAdopted);
+  EXPECT_EQ(stats.guideGain, gain);
+  EXPECT_EQ(stats.lanes, PathLanes::kLanes);
+  EXPECT_TRUE(stats.joinDepthAdopted);
+  EXPECT_FALSE(stats.joinDepthTrial);
+  EXPECT_EQ(stats.joinDepth, -1);
+
+  SessionSettings bsdf = settings;
+  bsdf.mode = SamplingMode::Brdf;
+  bsdf.connections.paths = settings.connections.pathsFor(settings.width * settings.height, SamplingMode::Mis);
+  bsdf.connections.joinDepth = -1;
+  ProgressiveSession expected(scene, moved(start), bsdf);
+  EXPECT_EQ(relMse(after, finalImage(expected)), 0.0);
+
+  // A restart of the session (new settings in the viewer) forgets it.
+  ProgressiveSession fresh(scene, moved(start), settings);
+  finalImage(fresh);
+  EXPECT_FALSE(fresh.stats().guideSwitchAdopted);
+  EXPECT_EQ(fresh.stats().guideSwitchPass, int(GuideSwitch::kDecisionPass));
+}
+
+// The join depth trial's depth 1 is kept only into a view whose samples vary as little as the deciding
+// view's: on the Cornell box a small move keeps it; on door_ajar, from the lit room (depth 1 chosen) to
+// the other, lit through the slit, the trial runs again.
+TEST(Session, AKeptJoinDepthOneNeedsAViewAsEvenlyLit) {
+  SessionSettings settings = small(SamplingMode::Mis, int(GuideSwitch::kDecisionPass) + 2);
+  settings.width = 96;
+  settings.height = 72;
+  {
+    const auto scene = cornell();
+    ProgressiveSession session(scene, defaultCamera(scene->data()), settings);
+    finalImage(session);
+    ASSERT_EQ(session.stats().joinDepth, 1) << "the Cornell box's trial chose depth 1 before";
+    session.setCamera(moved(defaultCamera(scene->data())));
+    finalImage(session);
+    const SessionStats stats = session.stats();
+    EXPECT_TRUE(stats.joinDepthAdopted);
+    EXPECT_FALSE(stats.joinDepthTrial);
+    EXPECT_EQ(stats.joinDepth, 1);
+  }
+  const auto scene = std::make_shared<const RenderScene>(loadGltf(test::sourceDir() + "/scenes/door_ajar.gltf"));
+  CameraData litRoom = defaultCamera(scene->data());
+  litRoom.eye = glm::vec3(-3.6f, 1.4f, 1.6f);
+  litRoom.target = glm::vec3(-0.5f, 1.0f, -1.2f);
+  ProgressiveSession session(scene, litRoom, settings);
+  finalImage(session);
+  ASSERT_EQ(session.stats().joinDepth, 1) << "the lit room's trial chose depth 1 before";
+  session.setCamera(defaultCamera(scene->data()));
+  finalImage(session);
+  const SessionStats stats = session.stats();
+  EXPECT_FALSE(stats.joinDepthAdopted);
+  EXPECT_TRUE(stats.joinDepthTrial);
+  EXPECT_TRUE(stats.joinDepthDecided);
+  EXPECT_EQ(stats.joinDepth, -1);
 }
 
 // `--join-depth auto` in the viewer: past the trial's passes the session has decided between the
