@@ -5,12 +5,14 @@
 // took twice a later pass's time.
 //
 // A kept decision only changes which unbiased estimator a pass uses, so every view stays unbiased;
-// what a wrong one costs is efficiency, so each is kept only where that cost is small:
-// - mis's guide switch (BSDF samples in lanes) once it turned on: on every scene the lanes serve it
-//   did (forecast gains 0.83-1.0, guide_switch.h), since what the guide takes off there the joins take
-//   off too; where it stays off, the next view measures again.
-// - the join depth trial's every vertex: the trial's own fallback, at most 1/0.86 of depth 1's
-//   efficiency where depth 1 would win.
+// what a wrong one costs is efficiency:
+// - mis's guide switch (BSDF samples in lanes) once it turned on. Its forecast, what the guide takes
+//   off the first vertex's second moment, follows the scene's light more than the view: on the scenes
+//   the lanes serve the joins take off most of what the guide would (guide_switch.h). Where it stayed
+//   off (door_ajar at 640x360 and larger, where the guide pays), the next view measures again. A keep
+//   that is wrong for a view costs that view what the guide would have taken off; not measured.
+// - the join depth trial's every vertex: the trial's own fallback; where depth 1 won, it had 0.86-0.98
+//   of every vertex's relMSE x time (the skylit hall, the Cornell box, lamp_rooms).
 // - its depth 1 only while the new view's samples vary about as little as the deciding view's did:
 //   depth 1 wins where the lights are found directly, and loses 2-4x per sample where light comes
 //   through a slit (door_ajar), where samples vary 30x more (Film::sampleRelativeVariance: the Cornell
