@@ -8,8 +8,12 @@
 //                `previewPasses` and `previewSeconds`, with fewer clusters per pixel)
 //   3. refine    the guide (guided modes), then path-traced passes into the mode's own film, until
 //                `maxSpp`
-// What a view's first passes measure about the scene rather than the view (SceneDecisions) is kept
-// across camera moves, so that a later view need not spend its first passes on it again.
+// The shown image is the newest stage with something to show; the path-traced film fades in over the
+// preview from its first pass and has taken over at `handoverSpp` samples, so the picture is never
+// black, never steps back to much more noise and never waits behind a still preview. Films are kept
+// per mode while the camera stays, so flipping back to a mode shows its image at once. What a view's
+// first passes measure about the scene rather than the view (SceneDecisions) is kept across camera
+// moves, so that a later view need not spend its first passes on it again.
 #pragma once
 #include <atomic>
 #include <condition_variable>
