@@ -3,7 +3,7 @@
 // The guide's directions are drawn in radiance(), one path at a time; BSDF sampling runs eight paths
 // at a time in AVX2 lanes (path_lanes.h), joins and weight window included, at 0.78-0.85x the render
 // time of a guided sample on door_ajar and two_rooms (32 spp, 320x240, seeds 1 and 2, on 190c20b; the
-// same estimator with --bsdf-prob 1: 0.97-1.02x). Where the guide takes less than that off a sample's
+// same estimator with --bsdf-prob 1: 0.97-1.02x), and at 0.63-0.70x since (kLanesCostShare). Where the guide takes less than that off a sample's
 // variance, the lanes' BSDF samples are the better buy. On those scenes it took nothing off: at 32
 // spp `mis` and `mis --bsdf-prob 1` had the same relMSE within the seeds' spread (door_ajar 0.0922
 // and 0.0923, 0.0901 and 0.0878; two_rooms 0.00785 and 0.00790, 0.00794 and 0.00787).
@@ -27,8 +27,13 @@ namespace vpl {
 
 class GuideSwitch {
  public:
-  // The lanes' render time per sample over a guided one's, at the same joins (see above).
-  static constexpr double kLanesCostShare = 0.8;
+  // The lanes' render time per sample over a guided one's, at the same joins (see above). 0.8 when the
+  // switch came (190c20b); since the joins in vector form and the lanes' light samples, 0.63-0.70
+  // (2026-12-07, 1eb9216, 24 spp, seed 1, render phase of `brdf --connect-paths N --join-depth -1`
+  // over `mis --guide-switch off --join-depth -1`: door_ajar 0.65 at 320x240 and 0.63 at 640x360,
+  // two_rooms 0.69, the Cornell box 0.70). With 0.8, door_ajar's forecast (0.75 at 640x360) kept the
+  // guide there, at 0.55x the lanes' samples in 10 s and 1.8x their relMSE between two seeds.
+  static constexpr double kLanesCostShare = 0.67;
   static constexpr uint64_t kDecisionPass = JoinDepthTrial::kLastPass + 1;
 
   // After `passes` complete passes, with the learner's forecast `guideGain` (-1: none) and whether
