@@ -8,9 +8,9 @@
 // what a wrong one costs is efficiency:
 // - mis's guide switch (BSDF samples in lanes) once it turned on. Its forecast, what the guide takes
 //   off the first vertex's second moment, follows the scene's light more than the view: on the scenes
-//   the lanes serve the joins take off most of what the guide would (guide_switch.h). Where it stayed
-//   off (door_ajar at 640x360 and larger, where the guide pays), the next view measures again. A keep
-//   that is wrong for a view costs that view what the guide would have taken off; not measured.
+//   the lanes serve the joins take off most of what the guide would (guide_switch.h: it turned on on
+//   each of them). Where it stayed off, the next view measures again. A keep that is wrong for a view
+//   costs that view what the guide would have taken off; not measured.
 // - the join depth trial's every vertex: the trial's own fallback; where depth 1 won, it had 0.86-0.98
 //   of every vertex's relMSE x time (the skylit hall, the Cornell box, lamp_rooms).
 // - its depth 1 only while the new view's samples vary about as little as the deciding view's did:
