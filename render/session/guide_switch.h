@@ -50,18 +50,19 @@ class GuideSwitch {
   // On from the first pass, as an earlier view of the same scene decided with forecast `guideGain`
   // (the viewer keeps the decision across camera moves: ProgressiveSession).
   void adopt(double guideGain) {
-    decided_ = on_ = adopted_ = true;
+    decided_ = on_ = true;
     gain_ = guideGain;
     fromPass_ = 0;
   }
   bool on() const { return on_; }
-  bool adopted() const { return adopted_; }
+  // update() turns it on from kDecisionPass, so from pass 0 only by adopt().
+  bool adopted() const { return on_ && fromPass_ == 0; }
   bool decided() const { return decided_; }
   double gain() const { return gain_; }
   uint64_t fromPass() const { return fromPass_; }
 
  private:
-  bool on_ = false, decided_ = false, adopted_ = false;
+  bool on_ = false, decided_ = false;
   double gain_ = -1.0;
   uint64_t fromPass_ = 0;
 };

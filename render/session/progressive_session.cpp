@@ -353,17 +353,21 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
     stats_.joinDepth = SessionStats::kNoJoins;
     stats_.joinDepthTrial = stats_.joinDepthDecided = false;
   }
+  // --join-depth auto: an earlier view's depth (SceneDecisions), or the trial. A kept depth 1 waits for
+  // this view's relative variance (-1 until read, after kVariancePass); until then the joins are from
+  // every vertex, as in the trial's first passes.
+  const bool autoJoinDepth = settings_.connections.joinDepth == ConnectionSettings::kJoinDepthAuto;
+  const auto chooseJoinDepth = [&](double variance) {
+    if (decided.keepsJoinDepth(variance)) {
+      mine.joinDepthAdopted = true;
+      mine.joins->setJoinDepth(decided.joinDepth);
+    } else if (variance >= 0.0 || decided.joinDepth == SceneDecisions::kUndecided) {
+      mine.joinTrial = std::make_unique<JoinDepthTrial>(w, h);
+    }
+  };
   if (joinPaths > 0 && !mine.joins) {
     mine.joins = std::make_unique<LightVertexCache>(settings_.connections);
-    // A kept depth 1 waits for this view's variance (after kVariancePass) before the trial would start;
-    // until then the joins are from every vertex, as in the trial's first passes.
-    if (settings_.connections.joinDepth == ConnectionSettings::kJoinDepthAuto) {
-      if (decided.keepsJoinDepth(-1.0)) {
-        mine.joinDepthAdopted = true;
-        mine.joins->setJoinDepth(decided.joinDepth);
-      } else if (decided.joinDepth == SceneDecisions::kUndecided)
-        mine.joinTrial = std::make_unique<JoinDepthTrial>(w, h);
-    }
+    if (autoJoinDepth) chooseJoinDepth(-1.0);
   }
   {
     std::lock_guard lock(mutex_);
@@ -442,17 +446,9 @@ void ProgressiveSession::runUntilChanged(CameraState& state, const Request& requ
         decided.joinDepthVariance = mine.variance;
       }
     }
-    if (mine.joins && settings_.connections.joinDepth == ConnectionSettings::kJoinDepthAuto && !cancelled() &&
-        mine.complete + 1 == int(SceneDecisions::kVariancePass)) {
+    if (mine.joins && autoJoinDepth && !cancelled() && mine.complete + 1 == int(SceneDecisions::kVariancePass)) {
       mine.variance = mine.film->sampleRelativeVariance();
-      if (!mine.joinTrial && !mine.joinDepthAdopted) {
-        if (decided.keepsJoinDepth(mine.variance)) {
-          mine.joinDepthAdopted = true;
-          mine.joins->setJoinDepth(decided.joinDepth);
-        } else {
-          mine.joinTrial = std::make_unique<JoinDepthTrial>(w, h);
-        }
-      }
+      if (!mine.joinTrial && !mine.joinDepthAdopted) chooseJoinDepth(mine.variance);
     }
     if (mine.joins) {
       std::lock_guard lock(mutex_);
