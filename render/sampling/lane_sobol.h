@@ -8,6 +8,7 @@
 // built for different CPUs.
 #pragma once
 #include <cstdint>
+#include "render/sampling/pixel_sampler.h"
 #include "render/sampling/rng.h"
 #include "render/sampling/sobol.h"
 
@@ -29,20 +30,36 @@ inline void toUnitFloat(const U& v, F& out) { out = __builtin_convertvector(v >>
 
 // Both coordinates of each lane's slot: pixelKey and reversedIndex are the lane's
 // PixelSampler::pixelKey() and reversedIndex(), slot its PixelSampler::slotOf(vertex, dimension).
+// The joined slot (PixelSampler::kJoinedSlot) takes its shuffle from the slot it joins and the third
+// and fourth Sobol' dimensions, as PixelSampler::stratifiedPair does.
 template <class U, class U64, class F>
 inline void point(const U64& pixelKey, const U& reversedIndex, const U& slot, F& x, F& y) {
+  constexpr int kN = int(sizeof(U) / sizeof(uint32_t));
   U64 slotHash = pixelKey + __builtin_convertvector(slot, U64);
   mix64InPlace(slotHash);
   const U low = __builtin_convertvector(slotHash, U), high = __builtin_convertvector(slotHash >> 32, U);
+  const auto joined = slot == PixelSampler::kJoinedSlot;
+  bool anyJoined = false;
+  for (int k = 0; k < kN; ++k) anyJoined |= joined[k] != 0;
+  U shuffle = low;
+  if (anyJoined) {
+    U64 joinedTo = pixelKey + uint64_t(PixelSampler::kJoinedToSlot);
+    mix64InPlace(joinedTo);
+    shuffle = joined ? __builtin_convertvector(joinedTo, U) : low;
+  }
   U index = reversedIndex;  // the shuffled index (PixelSampler::shuffledIndex)
-  sobol::nestedScrambleReversedInPlace(index, low);
+  sobol::nestedScrambleReversedInPlace(index, shuffle);
   reverseBits(index);
-  U first = index;
+  U first = index;  // the van der Corput point reversed is the index itself
+  if (anyJoined)
+    for (int k = 0; k < kN; ++k)
+      if (joined[k]) first[k] = sobol::reversedSobol(sobol::kThirdByByte, index[k]);
   sobol::nestedScrambleReversedInPlace(first, high);
   reverseBits(first);
   toUnitFloat(first, x);
   U second;
-  for (int k = 0; k < int(sizeof(U) / sizeof(uint32_t)); ++k) second[k] = sobol::reversedSobolSecond(index[k]);
+  for (int k = 0; k < kN; ++k)
+    second[k] = joined[k] ? sobol::reversedSobol(sobol::kFourthByByte, index[k]) : sobol::reversedSobolSecond(index[k]);
   U64 secondHash = slotHash;
   mix64InPlace(secondHash);
   const U secondKey = __builtin_convertvector(secondHash, U);

@@ -1,11 +1,13 @@
 // The Sobol' (0,2)-sequence with hash-based Owen scrambling: the generator behind every stratified
 // number of the renderer (pixel_sampler.h decides which decision draws from which dimension).
 //
-// Only the first two Sobol' dimensions are used: the van der Corput sequence and its partner whose
+// Most consumers use the first two Sobol' dimensions: the van der Corput sequence and its partner whose
 // generator matrix is Pascal's triangle mod 2. Together they form a (0,2)-sequence in base 2: every
 // aligned block of 2^m points is a (0,m,2)-net, one point in each elementary interval of area 2^-m.
 // More dimensions come from "padding" (Kollig & Keller 2002; pbrt-v4's PaddedSobolSampler): every
-// consumer gets its own copy of these two, shuffled and scrambled independently of the others.
+// consumer gets its own copy of these two, shuffled and scrambled independently of the others. The
+// third and fourth dimensions (Joe & Kuo's direction numbers) serve the one consumer that shares
+// another's shuffle, so that the two form one 4D Sobol' point (pixel_sampler.h says which).
 // All values are 0.32 fixed-point fractions until toUnitFloat().
 #pragma once
 #include <array>
@@ -30,27 +32,41 @@ inline uint32_t reverseBits(uint32_t v) {
 // First dimension: the base-2 radical inverse of the index.
 inline uint32_t vanDerCorput(uint32_t index) { return reverseBits(index); }
 
-// Direction numbers of the second dimension (primitive polynomial x + 1): v_1 = 1/2 and
-// v_k = v_{k-1} xor v_{k-1} / 2, the rows of Pascal's triangle mod 2. Bit k of the index adds v_{k+1}.
-inline constexpr std::array<uint32_t, 32> kSecondDirections = [] {
-  std::array<uint32_t, 32> d{};
-  uint32_t v = 1u << 31;
-  for (uint32_t& x : d) {
-    x = v;
-    v ^= v >> 1;
+// The direction numbers of a Sobol' dimension from its primitive polynomial of degree s (a: its
+// inner coefficients as bits, highest first) and its initial numbers m_1..m_s (odd, m_k < 2^k):
+// v_k = m_k / 2^k, then v_k = v_{k-s} xor v_{k-s} / 2^s xor the a-selected v_{k-j} (Bratley & Fox 1988).
+// Bit k of the index adds v_{k+1}.
+inline constexpr std::array<uint32_t, 32> directionNumbers(int s, uint32_t a, std::array<uint32_t, 3> m) {
+  std::array<uint32_t, 32> v{};
+  for (int k = 1; k <= 32; ++k) {
+    if (k <= s) {
+      v[size_t(k - 1)] = m[size_t(k - 1)] << (32 - k);
+      continue;
+    }
+    uint32_t x = v[size_t(k - s - 1)] ^ (v[size_t(k - s - 1)] >> s);
+    for (int j = 1; j < s; ++j)
+      if ((a >> (s - 1 - j)) & 1u) x ^= v[size_t(k - j - 1)];
+    v[size_t(k - 1)] = x;
   }
-  return d;
-}();
+  return v;
+}
+// The second dimension (x + 1): v_k = v_{k-1} xor v_{k-1} / 2, the rows of Pascal's triangle mod 2.
+// The third and fourth: Joe & Kuo's (2008) first two entries past it, x^2 + x + 1 with m = 1, 3 and
+// x^3 + x + 1 with m = 1, 3, 1.
+inline constexpr std::array<uint32_t, 32> kSecondDirections = directionNumbers(1, 0, {1});
+inline constexpr std::array<uint32_t, 32> kThirdDirections = directionNumbers(2, 1, {1, 3});
+inline constexpr std::array<uint32_t, 32> kFourthDirections = directionNumbers(3, 1, {1, 3, 1});
 
-// The index byte by byte: kSecondByByte[b][x] is the xor of the direction numbers of the bits set
-// in x as byte b of the index (4 KB, made at compile time), four reads instead of a loop over bits.
-// Stored bit-reversed, the form the scramble below works in.
-inline constexpr auto kSecondByByte = [] {
-  std::array<std::array<uint32_t, 256>, 4> table{};
+// The index byte by byte: table[b][x] is the xor of the direction numbers of the bits set in x as
+// byte b of the index (4 KB a dimension, made at compile time), four reads instead of a loop over
+// bits. Stored bit-reversed, the form the scramble below works in.
+using ByteTable = std::array<std::array<uint32_t, 256>, 4>;
+inline constexpr ByteTable byteTable(const std::array<uint32_t, 32>& directions) {
+  ByteTable table{};
   for (int b = 0; b < 4; ++b)
     for (uint32_t x = 0; x < 256; ++x)
       for (int bit = 0; bit < 8; ++bit)
-        if (x & (1u << bit)) table[size_t(b)][x] ^= kSecondDirections[size_t(8 * b + bit)];
+        if (x & (1u << bit)) table[size_t(b)][x] ^= directions[size_t(8 * b + bit)];
   for (auto& row : table)
     for (uint32_t& v : row) {
       uint32_t r = 0;
@@ -58,13 +74,18 @@ inline constexpr auto kSecondByByte = [] {
       v = r;
     }
   return table;
-}();
-
-inline uint32_t reversedSobolSecond(uint32_t index) {
-  return kSecondByByte[0][index & 0xffu] ^ kSecondByByte[1][(index >> 8) & 0xffu] ^
-         kSecondByByte[2][(index >> 16) & 0xffu] ^ kSecondByByte[3][index >> 24];
 }
+inline constexpr ByteTable kSecondByByte = byteTable(kSecondDirections);
+inline constexpr ByteTable kThirdByByte = byteTable(kThirdDirections);
+inline constexpr ByteTable kFourthByByte = byteTable(kFourthDirections);
+
+inline uint32_t reversedSobol(const ByteTable& table, uint32_t index) {
+  return table[0][index & 0xffu] ^ table[1][(index >> 8) & 0xffu] ^ table[2][(index >> 16) & 0xffu] ^ table[3][index >> 24];
+}
+inline uint32_t reversedSobolSecond(uint32_t index) { return reversedSobol(kSecondByByte, index); }
 inline uint32_t sobolSecond(uint32_t index) { return reverseBits(reversedSobolSecond(index)); }
+inline uint32_t sobolThird(uint32_t index) { return reverseBits(reversedSobol(kThirdByByte, index)); }
+inline uint32_t sobolFourth(uint32_t index) { return reverseBits(reversedSobol(kFourthByByte, index)); }
 
 // Owen's nested uniform scramble (1995) by a hash (Laine & Karras 2011; the multipliers are Vegdahl's
 // 2021 improvement, the hash pbrt-v4 calls FastOwenScrambler). Owen flips each binary digit of the
@@ -92,6 +113,12 @@ inline uint32_t owenScramble(uint32_t v, uint32_t seed) { return reverseBits(nes
 inline uint32_t scrambledVanDerCorput(uint32_t index, uint32_t seed) { return reverseBits(nestedScrambleReversed(index, seed)); }
 inline uint32_t scrambledSobolSecond(uint32_t index, uint32_t seed) {
   return reverseBits(nestedScrambleReversed(reversedSobolSecond(index), seed));
+}
+inline uint32_t scrambledSobolThird(uint32_t index, uint32_t seed) {
+  return reverseBits(nestedScrambleReversed(reversedSobol(kThirdByByte, index), seed));
+}
+inline uint32_t scrambledSobolFourth(uint32_t index, uint32_t seed) {
+  return reverseBits(nestedScrambleReversed(reversedSobol(kFourthByByte, index), seed));
 }
 
 // A shuffle of the sequence's order (Burley 2020): the same scramble applied to the index itself,

@@ -117,9 +117,14 @@ TEST_P(GuidedModes, AgreeWithBsdfSamplingPixelByPixel) {
   if (c.roulette == RouletteRule::Auto) EXPECT_EQ(windowed, kBatches) << "the auto rule did not switch to the window";
   EXPECT_EQ(discarded, 0u);
   // Sampling glossy lobes from the guide alone (metropolis, mixture) leaves rare, large weights: at
-  // 65536 spp one pixel of cornell_glossy still moved from 35 % below brdf to 50 % above it. Those
-  // modes get the heavy-tail bounds there.
-  const bool heavyTails = std::string(c.scene) == "cornell_glossy.gltf" && c.mode != SamplingMode::Mis;
+  // 65536 spp one pixel of cornell_glossy still moved from 35 % below brdf to 50 % above it. brdf's own
+  // batches there have rare large samples too (light reflected by the glossy walls onto the matte
+  // ones): one pixel of its 16 batches sat 8 standard errors below both mis and mis with the chain.
+  // Since vertex 1's direction joined vertex 0's (pixel_sampler.h) the regular noise is lower and those
+  // samples weigh more: over six sets of brdf seeds mis's mean z^2 is 1.20-1.84 (1.33-1.55 before),
+  // its mean z the same (+0.22 on average both ways, within the bound). Every mode there gets the
+  // heavy-tail bounds.
+  const bool heavyTails = std::string(c.scene) == "cornell_glossy.gltf";
   test::expectAgreement(test::compareEstimates(guided, reference), caseName(c) + " against brdf",
                         heavyTails ? test::kHeavyTailBounds : test::AgreementBounds{});
 }

@@ -3,6 +3,7 @@
 // stratified (one per elementary interval), and slots, pixels and seeds are independent of each
 // other. The tile renderer hands pass k of a pixel sample index k.
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <cmath>
 #include <mutex>
@@ -41,6 +42,40 @@ std::string netDefect(const std::vector<glm::vec2>& points, int m) {
                std::to_string(c) + " holds " + std::to_string(count[c]);
   }
   return "";
+}
+
+// The quality parameter t of 2^m points in [0,1)^d: the least t for which every elementary interval
+// of volume 2^(t-m) (2^q_i parts along each axis i, the q_i summing to m - t) holds exactly 2^t points.
+// A (0,m,2)-net has t = 0; Sobol's first four dimensions reach t <= 3 for m <= 12.
+template <size_t D>
+int netQuality(const std::vector<std::array<float, D>>& points, int m) {
+  for (int t = 0; t <= m; ++t) {
+    const int k = m - t;
+    bool holds = true;
+    std::array<int, D> q{};
+    // Every composition of k into D parts, q[D - 1] taking what the others leave.
+    const auto visit = [&](auto&& self, size_t axis, int left) -> void {
+      if (!holds) return;
+      if (axis + 1 == D) {
+        q[axis] = left;
+        std::vector<int> count(size_t(1) << k, 0);
+        for (const auto& p : points) {
+          size_t cell = 0;
+          for (size_t i = 0; i < D; ++i) cell = (cell << q[i]) | size_t(p[i] * float(1 << q[i]));
+          ++count[cell];
+        }
+        for (int c : count) holds &= c == (1 << t);
+        return;
+      }
+      for (int part = 0; part <= left; ++part) {
+        q[axis] = part;
+        self(self, axis + 1, left - part);
+      }
+    };
+    visit(visit, 0, k);
+    if (holds) return t;
+  }
+  return m;
 }
 
 // "" when each of the 2^m intervals of width 2^-m holds exactly one value.
@@ -129,6 +164,28 @@ TEST(Sobol, FirstTwoDimensionsAreA02Sequence) {
     }
 }
 
+// The third and fourth dimensions, from Joe & Kuo's direction numbers: each a (0,1)-sequence, and the
+// four together a (t,4)-sequence whose first 2^m points have Sobol's own t (at most 3 up to 2^12; a
+// wrong initial number or polynomial raises it), in every aligned block.
+TEST(Sobol, ThirdAndFourthDimensionsMakeA4DSequence) {
+  const int kQuality[13] = {0, 1, 1, 2, 2, 2, 2, 2, 3, 3, 2, 2, 3};  // the unscrambled first four dimensions
+  for (uint32_t block : {0u, 5u})
+    for (int m = 0; m <= 12; ++m) {
+      std::vector<std::array<float, 4>> points;
+      std::vector<float> third, fourth;
+      for (uint32_t i = 0; i < (1u << m); ++i) {
+        const uint32_t index = (block << m) | i;
+        points.push_back({unit(sobol::vanDerCorput(index)), unit(sobol::sobolSecond(index)), unit(sobol::sobolThird(index)),
+                          unit(sobol::sobolFourth(index))});
+        third.push_back(points.back()[2]);
+        fourth.push_back(points.back()[3]);
+      }
+      EXPECT_EQ(strataDefect(third, m), "") << "block " << block;
+      EXPECT_EQ(strataDefect(fourth, m), "") << "block " << block;
+      EXPECT_LE(netQuality(points, m), kQuality[m]) << "2^" << m << " points, block " << block;
+    }
+}
+
 TEST(Sobol, ShuffleMapsEveryPrefixOntoAnAlignedBlock) {
   for (uint32_t seed : {0u, 1u, 0xdeadbeefu, 0x9e3779b9u})
     for (int m = 0; m <= 14; ++m) {
@@ -179,6 +236,33 @@ TEST(PixelSampler, FirstSamplesOfEverySlotAreStratified) {
           ASSERT_EQ(strataDefect(values, m), "") << "vertex " << slot.vertex << " dimension " << int(slot.d) << ", pixel " << pixel;
           ASSERT_EQ(strataDefect(clusters, m), "") << "preview clusters, pixel " << pixel;
         }
+      }
+    }
+}
+
+// Vertex 1's BSDF direction is not padded: it shares vertex 0's shuffle, so in every pixel the first
+// 2^m samples of the two bounces' directions are one 4D net of Sobol's own quality (scrambles and the
+// shuffle keep nets), and vertex 1's alone a net of the third and fourth dimensions' (t <= 2). Padded
+// slots pair their points at random: vertex 2's direction with vertex 0's is no such net.
+TEST(PixelSampler, FirstTwoBouncesDirectionsAreOne4DNet) {
+  const int kQuality[11] = {0, 1, 1, 2, 2, 2, 2, 2, 3, 3, 2};
+  const int kSecondQuality[11] = {0, 0, 1, 2, 0, 1, 1, 1, 1, 1, 1};  // the third and fourth dimensions alone
+  for (uint64_t seed : {1ull, 77ull})
+    for (uint64_t pixel : {0ull, 4242ull, 65535ull}) {
+      std::vector<std::array<float, 4>> joined, padded;
+      std::vector<std::array<float, 2>> second;
+      for (int m = 0; m <= 10; ++m) {
+        while (joined.size() < size_t(1) << m) {
+          PixelSampler s(seed, pixel, joined.size());
+          const glm::vec2 a = s.get2D(0, VertexDimension::BsdfDirection), b = s.get2D(1, VertexDimension::BsdfDirection);
+          const glm::vec2 c = s.get2D(2, VertexDimension::BsdfDirection);
+          joined.push_back({a.x, a.y, b.x, b.y});
+          padded.push_back({a.x, a.y, c.x, c.y});
+          second.push_back({b.x, b.y});
+        }
+        ASSERT_LE(netQuality(joined, m), kQuality[m]) << "2^" << m << " samples, pixel " << pixel << ", seed " << seed;
+        ASSERT_LE(netQuality(second, m), kSecondQuality[m]) << "2^" << m << " samples, pixel " << pixel << ", seed " << seed;
+        if (m >= 8) EXPECT_GT(netQuality(padded, m), kQuality[m] + 2) << "2^" << m << " samples, pixel " << pixel;
       }
     }
 }
