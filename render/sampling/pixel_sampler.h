@@ -121,6 +121,11 @@ class PixelSampler {
   // The slot that is not padded (see above), and the slot whose shuffle it shares.
   static constexpr uint32_t kJoinedSlot = kFirstVertexSlot + 1 * uint32_t(VertexDimension::Count) + uint32_t(VertexDimension::BsdfDirection);
   static constexpr uint32_t kJoinedToSlot = kFirstVertexSlot + uint32_t(VertexDimension::BsdfDirection);
+  // The joined slot's point of the sampler with these keys (pixelKey(), reversedIndex()).
+  static glm::vec2 joinedPoint(uint64_t pixelKey, uint32_t reversedIndex) {
+    Pair p = joinedPair(pixelKey, reversedIndex);
+    return {p.x(), p.y()};
+  }
   // A stream of its own for a vertex's consumer of an unbounded count of numbers.
   Rng random(int vertex) {
     if (independent_) return Rng::hashed(independent_->next() | uint64_t(independent_->next()) << 32);
@@ -136,14 +141,18 @@ class PixelSampler {
   Pair stratifiedPair(uint32_t slot) const {
     Pair p;
     p.slotHash_ = mix64(pixelKey_ + slot);
-    if (slot == kJoinedSlot) {  // its own scrambles, the shuffle of the slot it joins
-      p.joined_ = true;
-      p.index_ = shuffledIndex(uint32_t(mix64(pixelKey_ + kJoinedToSlot)));
-      p.x_ = sobol::toUnitFloat(sobol::scrambledSobolThird(p.index_, uint32_t(p.slotHash_ >> 32)));
-      return p;
-    }
+    if (slot == kJoinedSlot) return joinedPair(pixelKey_, reversedIndex_);
     p.index_ = shuffledIndex(uint32_t(p.slotHash_));
     p.x_ = sobol::toUnitFloat(sobol::scrambledVanDerCorput(p.index_, uint32_t(p.slotHash_ >> 32)));
+    return p;
+  }
+  // The joined slot: its own scrambles, the shuffle of the slot it joins.
+  static Pair joinedPair(uint64_t pixelKey, uint32_t reversedIndex) {
+    Pair p;
+    p.slotHash_ = mix64(pixelKey + kJoinedSlot);
+    p.joined_ = true;
+    p.index_ = sobol::reverseBits(sobol::nestedScrambleReversed(reversedIndex, uint32_t(mix64(pixelKey + kJoinedToSlot))));
+    p.x_ = sobol::toUnitFloat(sobol::scrambledSobolThird(p.index_, uint32_t(p.slotHash_ >> 32)));
     return p;
   }
   // A slot of its own outside the vertices' (which stratified() already sends to the fallback).
