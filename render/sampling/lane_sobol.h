@@ -31,7 +31,7 @@ inline void toUnitFloat(const U& v, F& out) { out = __builtin_convertvector(v >>
 // Both coordinates of each lane's slot: pixelKey and reversedIndex are the lane's
 // PixelSampler::pixelKey() and reversedIndex(), slot its PixelSampler::slotOf(vertex, dimension).
 // The joined slot (PixelSampler::kJoinedSlot) takes the shuffle of the slot it joins and the third and
-// fourth Sobol' dimensions, as PixelSampler::joinedPair does. Always inlined: GCC otherwise kept this
+// fourth Sobol' dimensions, as PixelSampler::stratifiedPair gives it. Always inlined: GCC otherwise kept this
 // out of line, built for the default target rather than the lanes' AVX2 (brdf 7 % slower).
 template <class U, class U64, class F>
 [[gnu::always_inline]] inline void point(const U64& pixelKey, const U& reversedIndex, const U& slot, F& x, F& y) {

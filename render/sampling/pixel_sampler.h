@@ -121,11 +121,6 @@ class PixelSampler {
   // The slot that is not padded (see above), and the slot whose shuffle it shares.
   static constexpr uint32_t kJoinedSlot = kFirstVertexSlot + 1 * uint32_t(VertexDimension::Count) + uint32_t(VertexDimension::BsdfDirection);
   static constexpr uint32_t kJoinedToSlot = kFirstVertexSlot + uint32_t(VertexDimension::BsdfDirection);
-  // The joined slot's point of the sampler with these keys (pixelKey(), reversedIndex()).
-  static glm::vec2 joinedPoint(uint64_t pixelKey, uint32_t reversedIndex) {
-    Pair p = joinedPair(pixelKey, reversedIndex);
-    return {p.x(), p.y()};
-  }
   // A stream of its own for a vertex's consumer of an unbounded count of numbers.
   Rng random(int vertex) {
     if (independent_) return Rng::hashed(independent_->next() | uint64_t(independent_->next()) << 32);
@@ -139,19 +134,19 @@ class PixelSampler {
   // One hash of (pixel, slot) gives the slot's shuffle and its scrambles (the second coordinate's
   // through Pair::y(), when asked).
   Pair stratifiedPair(uint32_t slot) const {
+    if (slot == kJoinedSlot) return joinedPair();
     Pair p;
     p.slotHash_ = mix64(pixelKey_ + slot);
-    if (slot == kJoinedSlot) return joinedPair(pixelKey_, reversedIndex_);
     p.index_ = shuffledIndex(uint32_t(p.slotHash_));
     p.x_ = sobol::toUnitFloat(sobol::scrambledVanDerCorput(p.index_, uint32_t(p.slotHash_ >> 32)));
     return p;
   }
-  // The joined slot: its own scrambles, the shuffle of the slot it joins.
-  static Pair joinedPair(uint64_t pixelKey, uint32_t reversedIndex) {
+  // The joined slot: its own scrambles, the shuffle of the slot it joins (lane_sobol.h draws the same).
+  Pair joinedPair() const {
     Pair p;
-    p.slotHash_ = mix64(pixelKey + kJoinedSlot);
+    p.slotHash_ = mix64(pixelKey_ + kJoinedSlot);
     p.joined_ = true;
-    p.index_ = sobol::reverseBits(sobol::nestedScrambleReversed(reversedIndex, uint32_t(mix64(pixelKey + kJoinedToSlot))));
+    p.index_ = shuffledIndex(uint32_t(mix64(pixelKey_ + kJoinedToSlot)));
     p.x_ = sobol::toUnitFloat(sobol::scrambledSobolThird(p.index_, uint32_t(p.slotHash_ >> 32)));
     return p;
   }
