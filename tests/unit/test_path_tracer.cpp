@@ -60,11 +60,6 @@ Rendered renderScene(const RenderScene& scene, int width, int height, int spp, u
 struct MeanAndError {
   double mean, error;
 };
-// The same where joins are made: every pixel of a pass joins the same light vertices, so pixels are
-// not independent and their spread understates the error (the furnace's z-scores then spread over
-// +-5 across seeds). Passes are independent but for each pixel's stratified camera numbers, which only
-// make their means vary less, so the larger of the pixels' and the passes' errors is a safe one.
-MeanAndError channelMeanOverPasses(const Rendered& r, int channel);
 MeanAndError channelMean(const Image& image, int channel) {
   double sum = 0, sum2 = 0;
   const size_t n = image.pixels.size();
@@ -76,6 +71,10 @@ MeanAndError channelMean(const Image& image, int channel) {
   return {mean, std::sqrt(std::max(0.0, sum2 / n - mean * mean) / n)};
 }
 
+// The same where joins are made: every pixel of a pass joins the same light vertices, so pixels are
+// not independent and their spread understates the error (the furnace's z-scores then spread over
+// +-5 across seeds). Passes are independent but for each pixel's stratified camera numbers, which only
+// make their means vary less, so the larger of the pixels' and the passes' errors is a safe one.
 MeanAndError channelMeanOverPasses(const Rendered& r, int channel) {
   MeanAndError m = channelMean(r.image, channel);
   const size_t n = r.passMeans.size();
