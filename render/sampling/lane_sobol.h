@@ -59,7 +59,8 @@ template <class U, class U64, class F>
   reverseBits(first);
   toUnitFloat(first, x);
   U second;
-  for (int k = 0; k < kN; ++k) second[k] = sobol::reversedSobol(joined[k] ? sobol::kFourthByByte : sobol::kSecondByByte, index[k]);
+  for (int k = 0; k < kN; ++k)
+    second[k] = sobol::reversedSobol(joined[k] ? sobol::kFourthByByte : sobol::kSecondByByte, index[k]);
   U64 secondHash = slotHash;
   mix64InPlace(secondHash);
   const U secondKey = __builtin_convertvector(secondHash, U);

@@ -81,7 +81,8 @@ class PixelSampler {
     float y() {
       if (y_ < 0.0f) {
         const uint32_t seed = uint32_t(mix64(slotHash_));
-        y_ = sobol::toUnitFloat(joined_ ? sobol::scrambledSobolFourth(index_, seed) : sobol::scrambledSobolSecond(index_, seed));
+        y_ = sobol::toUnitFloat(joined_ ? sobol::scrambledSobolFourth(index_, seed)
+                                        : sobol::scrambledSobolSecond(index_, seed));
       }
       return y_;
     }
@@ -119,7 +120,8 @@ class PixelSampler {
     return kFirstVertexSlot + uint32_t(vertex) * uint32_t(VertexDimension::Count) + uint32_t(d);
   }
   // The slot that is not padded (see above), and the slot whose shuffle it shares.
-  static constexpr uint32_t kJoinedSlot = kFirstVertexSlot + 1 * uint32_t(VertexDimension::Count) + uint32_t(VertexDimension::BsdfDirection);
+  static constexpr uint32_t kJoinedSlot =
+      kFirstVertexSlot + 1 * uint32_t(VertexDimension::Count) + uint32_t(VertexDimension::BsdfDirection);
   static constexpr uint32_t kJoinedToSlot = kFirstVertexSlot + uint32_t(VertexDimension::BsdfDirection);
   // A stream of its own for a vertex's consumer of an unbounded count of numbers.
   Rng random(int vertex) {

@@ -3,10 +3,11 @@
 // The guide's directions are drawn in radiance(), one path at a time; BSDF sampling runs eight paths
 // at a time in AVX2 lanes (path_lanes.h), joins and weight window included, at 0.78-0.85x the render
 // time of a guided sample on door_ajar and two_rooms (32 spp, 320x240, seeds 1 and 2, on 190c20b; the
-// same estimator with --bsdf-prob 1: 0.97-1.02x), and at 0.63-0.70x since (kLanesCostShare). Where the guide takes less than that off a sample's
-// variance, the lanes' BSDF samples are the better buy. On those scenes it took nothing off: at 32
-// spp `mis` and `mis --bsdf-prob 1` had the same relMSE within the seeds' spread (door_ajar 0.0922
-// and 0.0923, 0.0901 and 0.0878; two_rooms 0.00785 and 0.00790, 0.00794 and 0.00787).
+// same estimator with --bsdf-prob 1: 0.97-1.02x), and at 0.63-0.70x since (kLanesCostShare). Where the
+// guide takes less than that off a sample's variance, the lanes' BSDF samples are the better buy. On
+// those scenes it took nothing off: at 32 spp `mis` and `mis --bsdf-prob 1` had the same relMSE within
+// the seeds' spread (door_ajar 0.0922 and 0.0923, 0.0901 and 0.0878; two_rooms 0.00785 and 0.00790,
+// 0.00794 and 0.00787).
 //
 // The forecast is the selection learner's (SelectionLearner::guideGain): the second moment of the
 // first vertex's continuation with the learned probabilities over that with the BSDF alone. It favours
