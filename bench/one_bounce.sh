@@ -9,7 +9,8 @@
 #
 # Environment: SCENES ("door_ajar two_rooms cornell_box"), SEEDS ("1 2"), THREADS (2), REF_SPP (2048),
 # SIZE ("160 120"), ROULETTE (the roulette rule of every render; default: the program's), GUIDED_FLAGS (the
-# guided modes' flags; default "--connect-paths 0 --guide-learning off", the paper's method; empty: vplview's defaults).
+# guided modes' flags; default "--connect-paths 0 --guide-learning off --guide-switch off", the paper's method: without
+# the switch off, mis hands the lanes' scenes to BSDF samples after pass 8; empty: vplview's defaults).
 # The reference is cached in OUT_DIR by the scene's content hash, size, spp and depth. Writes
 # OUT_DIR/one_bounce.csv and prints a Markdown table: mean relMSE over seeds, and each mode's ÷ brdf's.
 set -euo pipefail
@@ -21,7 +22,7 @@ exe=$build/vplview
 SCENES=${SCENES:-door_ajar two_rooms cornell_box}; SEEDS=${SEEDS:-1 2}; THREADS=${THREADS:-2}
 REF_SPP=${REF_SPP:-2048}; read -r W H <<<"${SIZE:-160 120}"
 rule=${ROULETTE:+--roulette $ROULETTE}
-guided=${GUIDED_FLAGS---connect-paths 0 --guide-learning off}
+guided=${GUIDED_FLAGS---connect-paths 0 --guide-learning off --guide-switch off}
 [ -x "$exe" ] || { echo "one_bounce: no $exe" >&2; exit 2; }
 [[ $spp =~ ^[0-9]+$ ]] || { echo "one_bounce: '$spp' is not a sample count" >&2; exit 2; }
 mkdir -p "$out"; out=$(cd "$out" && pwd)
