@@ -22,6 +22,7 @@
 #include "render/sampling/pixel_sampler.h"
 #include "render/sampling/rng.h"
 #include "render/sampling/sobol.h"
+#include "render/sampling/warps.h"
 
 namespace {
 
@@ -158,22 +159,12 @@ struct Integrand {
   double exact;
 };
 
-// Cosine-weighted direction by the concentric disk, the renderer's Lambertian sampling: its estimate of
+// The renderer's Lambertian sampling (sampleCosineHemisphere, the concentric disk lifted): its estimate of
 // the share of a square light (z = 1, x in [-0.25, 0.25], y in [0.1, 0.6]) is the indicator of a hit.
 double cosineLightHit(double u, double v) {
-  const double a = 2.0 * u - 1.0, b = 2.0 * v - 1.0;
-  double r, phi;
-  if (a == 0.0 && b == 0.0) return 0.0;
-  if (std::abs(a) > std::abs(b)) {
-    r = a;
-    phi = M_PI / 4.0 * (b / a);
-  } else {
-    r = b;
-    phi = M_PI / 2.0 - M_PI / 4.0 * (a / b);
-  }
-  const double x = r * std::cos(phi), y = r * std::sin(phi), z = std::sqrt(std::max(0.0, 1.0 - x * x - y * y));
-  if (z <= 0.0) return 0.0;
-  const double hx = x / z, hy = y / z;
+  const glm::vec3 w = vpl::sampleCosineHemisphere(glm::vec2(float(u), float(v)));
+  if (w.z <= 0.0f) return 0.0;
+  const double hx = double(w.x) / w.z, hy = double(w.y) / w.z;
   return (hx >= -0.25 && hx <= 0.25 && hy >= 0.1 && hy <= 0.6) ? 1.0 : 0.0;
 }
 
