@@ -31,9 +31,13 @@ namespace vpl {
 
 class GuideLearner {
  public:
-  // Learned cells per side of the equal-area map: 64 cells of 0.2 sr. A cache point sees a few
-  // hundred first vertices per pass (one per pixel of its slice); finer cells stay noisy for long.
-  static constexpr int kResolution = 8;
+  // Learned cells per side of the equal-area map: the guide's own 1024 cells of 0.0123 sr. A cache
+  // point sees a few hundred first vertices per pass, so a fine cell's sum is noisy for long, but
+  // the pdf stays exact and MIS with the BSDF bounds what a noisy cell costs, while coarse cells
+  // blur a glossy lobe's light: per sample at 64 spp, cornell_glossy's relMSE 0.88x that of 8x8
+  // cells (16x16: 0.89x), 0.91x at 10 s; the diffuse scenes within 0.3 %
+  // (docs/measurements/learned_guide_resolution.md).
+  static constexpr int kResolution = 32;
   static constexpr int kCells = kResolution * kResolution;
   // How many samples the VPL prior counts as: a cache point sees a few hundred per pass, so the
   // prior keeps about half the weight for the first pass or two (measured at 48 spp against 64:

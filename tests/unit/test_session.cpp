@@ -189,8 +189,13 @@ TEST(Session, AKeptJoinDepthOneNeedsAViewAsEvenlyLit) {
   settings.width = 96;
   settings.height = 72;
   {
+    // On the Cornell box depth 1 wins by a few percent (docs/measurements/guided_cost.md), so at this
+    // size the trial's choice follows the seed (seeds 1-6: depth 1 for 2, 3 and 5). This test is about
+    // keeping a choice, so it takes a seed that makes it.
+    SessionSettings cornellSettings = settings;
+    cornellSettings.seed = 2;
     const auto scene = cornell();
-    ProgressiveSession session(scene, defaultCamera(scene->data()), settings);
+    ProgressiveSession session(scene, defaultCamera(scene->data()), cornellSettings);
     finalImage(session);
     ASSERT_EQ(session.stats().joinDepth, 1) << "the Cornell box's trial chose depth 1 before";
     session.setCamera(moved(defaultCamera(scene->data())));
