@@ -137,7 +137,12 @@ void RenderOptions::addCommonTo(CLI::App& command) {
   command.add_option("--guided-vertices", guide.guidedVertices,
                      "guide only the first N vertices of every path (the authors guided 1); 0: every vertex near a cache point")
       ->check(CLI::Range(0, 1024));
-  command.add_option("--defensive", guide.defensive, "uniform share of the guide pdf")->check(CLI::Range(1e-6f, 1.0f));
+  command.add_option("--defensive", guide.defensive,
+                     "uniform share of the guide pdf: the VPL guide's, and the learned guides' of the guide-only modes")
+      ->check(CLI::Range(1e-6f, 1.0f));
+  command.add_option("--mis-defensive", guide.misDefensive,
+                     "mis: uniform share of the learned guides where the BSDF probability stays at least 0.1")
+      ->check(CLI::Range(1e-6f, 1.0f));
   command.add_option("--uniform-mutation", guide.uniformMutation, "Metropolis: probability of an independent direction")
       ->check(CLI::Range(0.0f, 1.0f));
   command.add_option("--perturb", perturbDegrees, "Metropolis perturbation cone, degrees")->check(CLI::Range(0.01f, 180.0f));

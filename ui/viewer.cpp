@@ -74,6 +74,7 @@ struct PanelSettings {
   float bsdfProbability;
   bool learnSelection;  // mis: learn the BSDF probability per cache point (bsdfProbability is then the start)
   float defensive;
+  float misDefensive;
   float uniformMutation;
   int roulette;  // index into kRoulettes
   bool connections;  // VPL connections in the guided modes
@@ -156,7 +157,7 @@ int runViewer(const ViewerOptions& options) {
     auto session = std::make_unique<ProgressiveSession>(scene, start, settings);
     PanelSettings panel{settings.preview.vpl.count, settings.preview.clustering.clusterBudget,
                         settings.guide.coneAngle * 57.29578f, settings.guide.bsdfProbability, settings.guide.learnSelection,
-                        settings.guide.defensive,
+                        settings.guide.defensive, settings.guide.misDefensive,
                         settings.guide.uniformMutation, rouletteIndex(settings.tracer.roulette),
                         settings.connections.paths != 0, settings.connections.learnChoice, settings.connections.joinsPerVertex,
                         joinDepthIndex(settings.connections.joinDepth),
@@ -274,6 +275,7 @@ int runViewer(const ViewerOptions& options) {
           ImGui::SliderFloat("MIS BSDF probability", &panel.bsdfProbability, 0.0f, 1.0f);
           ImGui::Checkbox("learn it per cache point", &panel.learnSelection);
           ImGui::SliderFloat("defensive", &panel.defensive, 0.001f, 1.0f);
+          ImGui::SliderFloat("defensive, mis's learned guides", &panel.misDefensive, 0.001f, 1.0f);
           ImGui::SliderFloat("uniform mutation", &panel.uniformMutation, 0.0f, 1.0f);
           ImGui::Combo("roulette", &panel.roulette, kRouletteNames, 4);
           ImGui::Checkbox("VPL connections (guided modes)", &panel.connections);
@@ -295,6 +297,7 @@ int runViewer(const ViewerOptions& options) {
             next.guide.bsdfProbability = std::clamp(panel.bsdfProbability, 0.0f, 1.0f);
             next.guide.learnSelection = panel.learnSelection;
             next.guide.defensive = std::clamp(panel.defensive, 0.001f, 1.0f);
+            next.guide.misDefensive = std::clamp(panel.misDefensive, 0.001f, 1.0f);
             next.guide.uniformMutation = std::clamp(panel.uniformMutation, 0.0f, 1.0f);
             next.tracer.roulette = kRoulettes[std::clamp(panel.roulette, 0, 3)];
             if (panel.connections != (settings.connections.paths != 0)) next.connections.paths = panel.connections ? -1 : 0;

@@ -23,13 +23,14 @@ void GuideLearner::TileLog::add(int cachePoint, const glm::vec3& wi, float value
   records_.push_back({cachePoint, uint16_t(cellOf(wi)), value});
 }
 
-GuideLearner::GuideLearner(const GuideField& field, int tiles, bool vplPrior)
-    : field_(field), vplPrior_(vplPrior), sums_(field.size()), samples_(field.size(), 0), tiles_(size_t(tiles)) {
+GuideLearner::GuideLearner(const GuideField& field, int tiles, bool vplPrior, float defensive)
+    : field_(field), vplPrior_(vplPrior), defensive_(defensive), sums_(field.size()), samples_(field.size(), 0),
+      tiles_(size_t(tiles)) {
   current_.reserve(field.size());
   const GuideSettings& s = field.settings();
   for (size_t c = 0; c < field.size(); ++c)
     current_.push_back(vplPrior ? field.point(int(c)).distribution
-                                : GuideDistribution(std::vector<GuideRepresentative>{}, 1.0f, s.defensive, s.bilinear));
+                                : GuideDistribution(std::vector<GuideRepresentative>{}, 1.0f, defensive_, s.bilinear));
 }
 
 GuideDistribution GuideLearner::blend(int c) const {
@@ -58,7 +59,7 @@ GuideDistribution GuideLearner::blend(int c) const {
   }
   // Bilinear, the prior's shares are already the interpolated guide's, so the blend is interpolated
   // once more: the prior's part a cell wider, against learned blocks four cells wide.
-  return GuideDistribution(weights, field_.settings().defensive, field_.settings().bilinear);
+  return GuideDistribution(weights, defensive_, field_.settings().bilinear);
 }
 
 void GuideLearner::update() {

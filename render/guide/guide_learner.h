@@ -59,8 +59,9 @@ class GuideLearner {
     std::vector<Record> records_;
   };
 
-  // `field` holds the priors and must outlive the learner. vplPrior false: learned only.
-  GuideLearner(const GuideField& field, int tiles, bool vplPrior);
+  // `field` holds the priors and must outlive the learner. vplPrior false: learned only. defensive: the
+  // uniform share of the learned tables (the priors keep the field's own).
+  GuideLearner(const GuideField& field, int tiles, bool vplPrior, float defensive);
 
   // The guide of cache point c for the pass being rendered.
   const GuideDistribution& distribution(int c) const { return current_[size_t(c)]; }
@@ -80,6 +81,7 @@ class GuideLearner {
 
   const GuideField& field_;
   bool vplPrior_;
+  float defensive_;
   std::vector<GuideDistribution> current_;
   std::vector<std::array<double, kCells>> sums_;
   std::vector<uint32_t> samples_;

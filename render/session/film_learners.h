@@ -3,9 +3,11 @@
 // The CLI's render job and the viewer's session keep one per film, hand its logs to every pass
 // and update it between passes.
 #pragma once
+#include <algorithm>
 #include <optional>
 #include "render/guide/guide_learner.h"
 #include "render/guide/guide_settings.h"
+#include "render/guide/selection_learner.h"
 #include "render/integrator/sampling_mode.h"
 
 namespace vpl {
@@ -15,7 +17,17 @@ class FilmLearners {
   // `guide` holds the priors and must outlive the learners.
   FilmLearners(const GuideField& guide, SamplingMode mode, const GuideSettings& settings, int tiles) {
     if (mode == SamplingMode::Mis && settings.learnSelection) selection_.emplace(guide.size(), tiles, settings.bsdfProbability);
-    if (settings.learnDirections) guides_.emplace(guide, tiles, settings.vplPrior);
+    if (settings.learnDirections) guides_.emplace(guide, tiles, settings.vplPrior, learnedDefensive(mode, settings));
+  }
+
+  // The uniform share of the learned guides: mis's own where its BSDF probability never falls below
+  // GuideSettings::kMisDefensiveBsdfShare (the learned one starts at the settings' and takes one of
+  // SelectionLearner::kCandidates), else the guide-only modes' (GuideSettings::misDefensive).
+  static float learnedDefensive(SamplingMode mode, const GuideSettings& settings) {
+    const float leastBsdf = settings.learnSelection ? std::min(settings.bsdfProbability, SelectionLearner::kCandidates.front())
+                                                    : settings.bsdfProbability;
+    return mode == SamplingMode::Mis && leastBsdf >= GuideSettings::kMisDefensiveBsdfShare ? settings.misDefensive
+                                                                                           : settings.defensive;
   }
 
   // The learners that a pass's continuations write to (absent ones as nullptr).

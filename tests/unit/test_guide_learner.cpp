@@ -4,6 +4,7 @@
 #include <vector>
 #include <gtest/gtest.h>
 #include "render/guide/guide_learner.h"
+#include "render/session/film_learners.h"
 #include "render/sampling/rng.h"
 #include "tests/unit/support.h"
 
@@ -53,7 +54,7 @@ double integral(const GuideDistribution& d) {
 
 TEST(GuideLearner, ThePriorDecidesTheFirstPass) {
   const GuideField f = field();
-  const GuideLearner withPrior(f, 2, true), learnedOnly(f, 2, false);
+  const GuideLearner withPrior(f, 2, true, settings().defensive), learnedOnly(f, 2, false, settings().defensive);
   for (const glm::vec3& w : {kPriorDirection, kLightDirection, glm::normalize(glm::vec3(1, 2, -3))}) {
     EXPECT_EQ(withPrior.distribution(0).pdf(w), f.point(0).distribution.pdf(w));
     EXPECT_NEAR(learnedOnly.distribution(0).pdf(w), 1.0 / (4.0 * M_PI), 1e-6);
@@ -63,7 +64,7 @@ TEST(GuideLearner, ThePriorDecidesTheFirstPass) {
 TEST(GuideLearner, MovesTheGuideToWhereTheLightComesFrom) {
   const GuideField f = field();
   for (const bool prior : {true, false}) {
-    GuideLearner learner(f, 2, prior);
+    GuideLearner learner(f, 2, prior, settings().defensive);
     const double before = learner.distribution(0).pdf(kLightDirection);
     learn(learner, 0, 32, 1024, 3);
     const GuideDistribution& d = learner.distribution(0);
@@ -82,24 +83,27 @@ TEST(GuideLearner, MovesTheGuideToWhereTheLightComesFrom) {
 
 TEST(GuideLearner, KeepsThePriorWhereNothingWasFound) {
   const GuideField f = field();
-  GuideLearner learner(f, 1, true);
+  GuideLearner learner(f, 1, true, settings().defensive);
   for (int i = 0; i < 100; ++i) learner.tileLog(0).add(0, kPriorDirection, 0.0f);
   learner.tileLog(0).add(0, kPriorDirection, NAN);  // counts as nothing found
   learner.update();
   EXPECT_EQ(learner.distribution(0).pdf(kPriorDirection), f.point(0).distribution.pdf(kPriorDirection));
 }
 
-// Learned tables are sampled exactly by both samplers and integrate to 1, with and without a prior
-// and at the cache point whose prior was empty.
+// Learned tables are sampled exactly by both samplers and integrate to 1, with and without a prior,
+// at the cache point whose prior was empty, and at both defensive shares (the guide-only modes', mis's).
 TEST(GuideLearner, LearnedPdfStaysExact) {
   const GuideField f = field();
+  for (const float defensive : {settings().defensive, settings().misDefensive})
   for (const bool prior : {true, false}) {
-    GuideLearner learner(f, 2, prior);
+    GuideLearner learner(f, 2, prior, defensive);
     for (int c : {0, 1}) {
       learn(learner, c, 3, 128, 5 + uint64_t(c));  // few samples: prior and learned cells both weigh
       const GuideDistribution& d = learner.distribution(c);
-      const std::string name = std::string(prior ? "vpl prior" : "no prior") + ", cache point " + std::to_string(c);
+      const std::string name = std::string(prior ? "vpl prior" : "no prior") + ", cache point " + std::to_string(c) +
+                               ", defensive " + std::to_string(defensive);
       ASSERT_FALSE(d.uniform()) << name << ": nothing was learned";
+      EXPECT_EQ(d.defensive(), defensive) << name;
       EXPECT_NEAR(integral(d), 1.0, 1e-4) << name;
       Rng rng(11);
       const auto pdf = [&](const glm::vec3& w) { return double(d.pdf(w)); };
@@ -110,6 +114,36 @@ TEST(GuideLearner, LearnedPdfStaysExact) {
       EXPECT_GT(two.pValue, 1e-4) << name << ": " << two.report;
     }
   }
+}
+
+// mis's learned guides take mis's defensive share wherever its BSDF probability cannot fall below
+// GuideSettings::kMisDefensiveBsdfShare; the guide-only modes, and mis where the guide alone may draw
+// a direction, keep the heavier one.
+TEST(GuideLearner, MisLearnsWithItsOwnDefensiveShareWhereTheBsdfStaysInTheMixture) {
+  GuideSettings s = settings();
+  ASSERT_LT(s.misDefensive, s.defensive);
+  EXPECT_EQ(FilmLearners::learnedDefensive(SamplingMode::Mis, s), s.misDefensive);  // learned, from 0.5
+  for (const SamplingMode guideOnly : {SamplingMode::Mixture, SamplingMode::Metropolis})
+    EXPECT_EQ(FilmLearners::learnedDefensive(guideOnly, s), s.defensive);
+  s.bsdfProbability = 0.05f;  // the learned probability starts below the share
+  EXPECT_EQ(FilmLearners::learnedDefensive(SamplingMode::Mis, s), s.defensive);
+  s.learnSelection = false;
+  EXPECT_EQ(FilmLearners::learnedDefensive(SamplingMode::Mis, s), s.defensive);  // fixed at 0.05
+  s.bsdfProbability = 0.5f;  // the paper's fixed probability
+  EXPECT_EQ(FilmLearners::learnedDefensive(SamplingMode::Mis, s), s.misDefensive);
+
+  // And the film's learned tables carry it.
+  const GuideField f = field();
+  FilmLearners film(f, SamplingMode::Mis, settings(), 1);
+  GuideLearners logs = film.logs();
+  ASSERT_NE(logs.directions, nullptr);
+  for (int i = 0; i < 64; ++i) logs.directions->tileLog(0).add(0, kLightDirection, 1.0f);
+  film.update();
+  EXPECT_EQ(logs.directions->distribution(0).defensive(), settings().misDefensive);
+  FilmLearners mixture(f, SamplingMode::Mixture, settings(), 1);
+  for (int i = 0; i < 64; ++i) mixture.logs().directions->tileLog(0).add(0, kLightDirection, 1.0f);
+  mixture.update();
+  EXPECT_EQ(mixture.logs().directions->distribution(0).defensive(), settings().defensive);
 }
 
 // A learned cell is a block of the guide's fine cells: a direction's learned cell holds its fine cell.
