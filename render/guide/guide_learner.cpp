@@ -5,22 +5,9 @@
 
 namespace vpl {
 
-namespace {
-constexpr int kFinePerLearned = GuideDistribution::kResolution / GuideLearner::kResolution;
-static_assert(kFinePerLearned * GuideLearner::kResolution == GuideDistribution::kResolution,
-              "a learned cell must be a block of the guide's fine cells");
-
-int learnedCellOfFine(int fine) {
-  const int row = fine / GuideDistribution::kResolution, col = fine % GuideDistribution::kResolution;
-  return (row / kFinePerLearned) * GuideLearner::kResolution + col / kFinePerLearned;
-}
-}  // namespace
-
-int GuideLearner::cellOf(const glm::vec3& w) { return learnedCellOfFine(GuideDistribution::cellOf(w)); }
-
 void GuideLearner::TileLog::add(int cachePoint, const glm::vec3& wi, float value) {
   if (!std::isfinite(value) || !(value >= 0.0f)) value = 0.0f;  // counts as a sample that found nothing
-  records_.push_back({cachePoint, uint16_t(cellOf(wi)), value});
+  records_.push_back({cachePoint, uint16_t(GuideDistribution::cellOf(wi)), value});
 }
 
 GuideLearner::GuideLearner(const GuideField& field, int tiles, bool vplPrior, float defensive)
@@ -42,23 +29,13 @@ GuideDistribution GuideLearner::blend(int c) const {
   if (!(learnedTotal > 0.0)) return hasPrior ? prior : current_[size_t(c)];  // nothing found yet: no evidence against
   const double n = double(samples_[size_t(c)]);
   const double lambda = vplPrior_ ? n / (n + kPriorSamples) : 1.0;
-  // The prior's mass per learned cell: within a learned cell, its mass goes half to the fine cells
-  // as the prior shares it among them (the VPLs see detail finer than the paths can learn for
-  // long) and half evenly (the prior may be wrong inside the cell too).
-  std::array<double, kCells> priorInBlock{};
-  if (hasPrior)
-    for (int f = 0; f < GuideDistribution::kCells; ++f) priorInBlock[size_t(learnedCellOfFine(f))] += prior.cellShare(f);
-  constexpr double kFineCells = double(kFinePerLearned * kFinePerLearned);
-  std::vector<float> weights(GuideDistribution::kCells);
-  for (int f = 0; f < GuideDistribution::kCells; ++f) {
-    const size_t b = size_t(learnedCellOfFine(f));
-    const double priorShare = hasPrior ? prior.cellShare(f) : 1.0 / GuideDistribution::kCells;
-    const double withinBlock = priorInBlock[b] > 0.0 ? 0.5 * prior.cellShare(f) / priorInBlock[b] + 0.5 / kFineCells
-                                                     : 1.0 / kFineCells;
-    weights[size_t(f)] = float((1.0 - lambda) * priorShare + lambda * sums[b] / learnedTotal * withinBlock);
+  std::vector<float> weights(kCells);
+  for (int f = 0; f < kCells; ++f) {
+    const double priorShare = hasPrior ? prior.cellShare(f) : 1.0 / kCells;
+    weights[size_t(f)] = float((1.0 - lambda) * priorShare + lambda * sums[size_t(f)] / learnedTotal);
   }
   // Bilinear, the prior's shares are already the interpolated guide's, so the blend is interpolated
-  // once more: the prior's part a cell wider, against learned blocks four cells wide.
+  // once more: the prior's part a cell wider than the learned part.
   return GuideDistribution(weights, defensive_, field_.settings().bilinear);
 }
 

@@ -4,14 +4,18 @@
 // blind to what the clusters blur (a slit, a wall between a cluster and the cache point) and to the
 // BSDF. The paths know better: at a cache point's first vertex, a direction w drawn with density q
 // brings back F/q, the luminance of everything the rest of the path contributed (MIS-weighted, so
-// what this continuation is responsible for). Summed into w's cell of a coarse equal-area map, these
-// records estimate each cell's share of the integral of F, the product that a perfect continuation
-// would sample (Müller et al. 2017 learn incident radiance in the same way, on an adaptive tree).
+// what this continuation is responsible for). Summed into w's cell of the guide's own equal-area map,
+// these records estimate each cell's share of the integral of F, the product that a perfect
+// continuation would sample (Müller et al. 2017 learn incident radiance in the same way, on an
+// adaptive tree). The cells are the guide's (1024 of 0.0123 sr): a cache point sees a few hundred
+// first vertices a pass, so a cell's sum is noisy for long, but the pdf stays exact and MIS with the
+// BSDF bounds what a noisy cell costs, while coarser learned cells blur a glossy lobe's light (per
+// sample at 64 spp, cornell_glossy's relMSE 0.88x that of 8x8 learned cells, 16x16: 0.89x; 0.91x at
+// 10 s; the diffuse scenes within 0.3 %: docs/measurements/learned_guide_resolution.md).
 //
 // Between passes every cache point's table becomes
 //   (1 - lambda) prior + lambda learned,   lambda = n / (n + kPriorSamples)
-// over the fine cells of GuideDistribution (each learned cell's mass shared among the fine cells it
-// holds half as the prior shares it, half evenly), with n the samples the point has seen: the VPLs decide the first pass and give way as
+// cell by cell, with n the samples the point has seen: the VPLs decide the first pass and give way as
 // evidence comes in. Without a prior (--guide-prior none) the first pass is uniform and lambda is 1
 // from the first sample on: a learned-only baseline close to practical path guiding.
 // A table is fixed during a pass and depends only on earlier passes, so each pass stays an unbiased
@@ -31,14 +35,7 @@ namespace vpl {
 
 class GuideLearner {
  public:
-  // Learned cells per side of the equal-area map: the guide's own 1024 cells of 0.0123 sr. A cache
-  // point sees a few hundred first vertices per pass, so a fine cell's sum is noisy for long, but
-  // the pdf stays exact and MIS with the BSDF bounds what a noisy cell costs, while coarse cells
-  // blur a glossy lobe's light: per sample at 64 spp, cornell_glossy's relMSE 0.88x that of 8x8
-  // cells (16x16: 0.89x), 0.91x at 10 s; the diffuse scenes within 0.3 %
-  // (docs/measurements/learned_guide_resolution.md).
-  static constexpr int kResolution = 32;
-  static constexpr int kCells = kResolution * kResolution;
+  static constexpr int kCells = GuideDistribution::kCells;  // learned at the guide's own cells
   // How many samples the VPL prior counts as: a cache point sees a few hundred per pass, so the
   // prior keeps about half the weight for the first pass or two (measured at 48 spp against 64:
   // within 1-6 % per scene, better on four of four, README).
@@ -71,8 +68,6 @@ class GuideLearner {
   // samples. Only between passes, when no tile is being rendered.
   void update();
 
-  // The learned cell of a direction (tests).
-  static int cellOf(const glm::vec3& w);
   // The mean of lambda over cache points: how far the guides have moved from the VPLs (JSON line).
   double meanLearnedShare() const;
 

@@ -22,7 +22,7 @@ class FilmLearners {
 
   // The uniform share of the learned guides: mis's own where its BSDF probability never falls below
   // GuideSettings::kMisDefensiveBsdfShare (the learned one starts at the settings' and takes one of
-  // SelectionLearner::kCandidates), else the guide-only modes' (GuideSettings::misDefensive).
+  // SelectionLearner::kCandidates), else the guide-only modes' (GuideSettings::defensive).
   static float learnedDefensive(SamplingMode mode, const GuideSettings& settings) {
     const float leastBsdf = settings.learnSelection ? std::min(settings.bsdfProbability, SelectionLearner::kCandidates.front())
                                                     : settings.bsdfProbability;

@@ -146,24 +146,5 @@ TEST(GuideLearner, MisLearnsWithItsOwnDefensiveShareWhereTheBsdfStaysInTheMixtur
   EXPECT_EQ(mixture.logs().directions->distribution(0).defensive(), settings().defensive);
 }
 
-// A learned cell is a block of the guide's fine cells: a direction's learned cell holds its fine cell.
-TEST(GuideLearner, LearnedCellsAreBlocksOfFineCells) {
-  Rng rng(9);
-  std::vector<int> blockOf(GuideDistribution::kCells, -1);
-  for (int i = 0; i < 100000; ++i) {
-    const glm::vec3 w = GuideDistribution::pointInCell(int(rng.uniform() * GuideDistribution::kCells) % GuideDistribution::kCells,
-                                                       rng.uniform2());
-    const int fine = GuideDistribution::cellOf(w), learned = GuideLearner::cellOf(w);
-    ASSERT_GE(learned, 0);
-    ASSERT_LT(learned, GuideLearner::kCells);
-    if (blockOf[size_t(fine)] < 0) blockOf[size_t(fine)] = learned;
-    EXPECT_EQ(blockOf[size_t(fine)], learned) << "fine cell " << fine;
-  }
-  std::vector<int> fineCount(GuideLearner::kCells, 0);
-  for (int b : blockOf)
-    if (b >= 0) ++fineCount[size_t(b)];
-  for (int n : fineCount) EXPECT_EQ(n, GuideDistribution::kCells / GuideLearner::kCells);
-}
-
 }  // namespace
 }  // namespace vpl
