@@ -5,7 +5,7 @@
 //   defensive          float  0.1    share of the uniform sphere density mixed into the guide pdf (measured: 0.01
 //                                    leaves heavy tails in the guide-only modes)
 //   misDefensive       float  0.02   the same share in mis's learned guides wherever mis's BSDF probability is at
-//                                    least kMisDefensiveBsdfShare (learned or fixed): the BSDF's share keeps the
+//                                    least the learned one's least candidate, 0.1 (learned or fixed): the BSDF's share keeps the
 //                                    mixture's density away from 0 where the guide has none, so the guide need not
 //                                    spend a tenth of its samples on the whole sphere. Against 0.1 (seeds 1-4):
 //                                    cornell_glossy's relMSE 0.95x per sample (64 spp, join depth fixed), 0.96x at
@@ -55,7 +55,6 @@ struct GuideSettings {
   float coneAngle = 0.356f;
   float defensive = 0.1f;
   float misDefensive = 0.02f;
-  static constexpr float kMisDefensiveBsdfShare = 0.1f;
   float uniformMutation = 0.5f;
   float perturbationAngle = 0.157f;
   int mutations = 1;

@@ -3,7 +3,6 @@
 // The CLI's render job and the viewer's session keep one per film, hand its logs to every pass
 // and update it between passes.
 #pragma once
-#include <algorithm>
 #include <optional>
 #include "render/guide/guide_learner.h"
 #include "render/guide/guide_settings.h"
@@ -20,14 +19,12 @@ class FilmLearners {
     if (settings.learnDirections) guides_.emplace(guide, tiles, settings.vplPrior, learnedDefensive(mode, settings));
   }
 
-  // The uniform share of the learned guides: mis's own where its BSDF probability never falls below
-  // GuideSettings::kMisDefensiveBsdfShare (the learned one starts at the settings' and takes one of
-  // SelectionLearner::kCandidates), else the guide-only modes' (GuideSettings::defensive).
+  // The uniform share of the learned guides: mis's own where its BSDF probability, fixed or the learned
+  // one's start, is at least the least the learner can choose (SelectionLearner::kCandidates), so that
+  // it never falls below that; else the guide-only modes' (GuideSettings::defensive).
   static float learnedDefensive(SamplingMode mode, const GuideSettings& settings) {
-    const float leastBsdf = settings.learnSelection ? std::min(settings.bsdfProbability, SelectionLearner::kCandidates.front())
-                                                    : settings.bsdfProbability;
-    return mode == SamplingMode::Mis && leastBsdf >= GuideSettings::kMisDefensiveBsdfShare ? settings.misDefensive
-                                                                                           : settings.defensive;
+    const float least = SelectionLearner::kCandidates.front();
+    return mode == SamplingMode::Mis && settings.bsdfProbability >= least ? settings.misDefensive : settings.defensive;
   }
 
   // The learners that a pass's continuations write to (absent ones as nullptr).

@@ -116,8 +116,8 @@ TEST(GuideLearner, LearnedPdfStaysExact) {
   }
 }
 
-// mis's learned guides take mis's defensive share wherever its BSDF probability cannot fall below
-// GuideSettings::kMisDefensiveBsdfShare; the guide-only modes, and mis where the guide alone may draw
+// mis's learned guides take mis's defensive share wherever its BSDF probability cannot fall below the
+// learned one's least candidate; the guide-only modes, and mis where the guide alone may draw
 // a direction, keep the heavier one.
 TEST(GuideLearner, MisLearnsWithItsOwnDefensiveShareWhereTheBsdfStaysInTheMixture) {
   GuideSettings s = settings();
